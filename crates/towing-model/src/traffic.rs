@@ -1,0 +1,276 @@
+//! Traffic: static hazards (circles) and target ships (ellipses) on straight
+//! courses, as in Du et al. (2022), Table 5 and eq. (9) / (14) (circle obstacles of
+//! radius `R_j`, ellipse obstacles with long axis `a_j`).
+//!
+//! Motion is exact and analytic: a target ship at `(x0, y0)` with course `chi`
+//! and speed `U`, activated at `t_a`, is at `(x0, y0) + U (t - t_a) (cos chi, sin chi)`
+//! for `t >= t_a`. Before `t_a` it does not exist: it reports its spawn position
+//! and size with kind 0 and speed 0 (see `paper/NOTES.md` section 2 for why the
+//! paper's targets B and C need a late activation).
+
+use crate::vessel::ParamError;
+
+/// `ObstacleOutput::kind` of an empty slot or an inactive target ship.
+pub const KIND_NONE: i32 = 0;
+/// `ObstacleOutput::kind` of a static circle.
+pub const KIND_CIRCLE: i32 = 1;
+/// `ObstacleOutput::kind` of a target ship (ellipse).
+pub const KIND_VESSEL: i32 = 2;
+
+/// Shape and motion of an obstacle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ObstacleShape {
+    /// A static hazard, a circle of the given diameter (m).
+    Circle {
+        /// Diameter `2 R_j` (m).
+        diameter: f64,
+    },
+    /// A target ship, an ellipse with its major axis along the course.
+    Vessel {
+        /// Length = major axis `a_j` (m).
+        length: f64,
+        /// Width = minor axis (m).
+        width: f64,
+        /// Course `chi` over ground, from North, clockwise (rad, `(-pi, pi]`).
+        course: f64,
+        /// Speed over ground (m/s, >= 0).
+        speed: f64,
+        /// Time at which it appears and starts moving (s, >= 0).
+        activation_time: f64,
+    },
+}
+
+/// One obstacle of a scenario.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Obstacle {
+    /// Name (unique within a scenario), e.g. `"A"`.
+    pub name: String,
+    /// Spawn position North (m).
+    pub x: f64,
+    /// Spawn position East (m).
+    pub y: f64,
+    /// Shape and motion.
+    pub shape: ObstacleShape,
+}
+
+/// What the plant reports about one obstacle slot at a time `t`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ObstacleOutput {
+    /// Centre North (m).
+    pub x: f64,
+    /// Centre East (m).
+    pub y: f64,
+    /// Heading = course (rad); 0 for static obstacles and empty slots.
+    pub psi: f64,
+    /// Speed (m/s); 0 before activation, for static obstacles and empty slots.
+    pub speed: f64,
+    /// Length (m): ellipse major axis, or the circle's diameter.
+    pub length: f64,
+    /// Width (m): ellipse minor axis, or the circle's diameter.
+    pub width: f64,
+    /// [`KIND_NONE`] (empty slot or inactive), [`KIND_CIRCLE`] or [`KIND_VESSEL`].
+    pub kind: i32,
+}
+
+impl ObstacleOutput {
+    /// An empty slot: all zero, kind 0.
+    pub const EMPTY: ObstacleOutput = ObstacleOutput {
+        x: 0.0,
+        y: 0.0,
+        psi: 0.0,
+        speed: 0.0,
+        length: 0.0,
+        width: 0.0,
+        kind: KIND_NONE,
+    };
+}
+
+impl Obstacle {
+    /// True when the obstacle exists at time `t` (static: always; ship: `t >= t_a`).
+    #[must_use]
+    pub fn is_active(&self, t: f64) -> bool {
+        match self.shape {
+            ObstacleShape::Circle { .. } => true,
+            ObstacleShape::Vessel {
+                activation_time, ..
+            } => t >= activation_time,
+        }
+    }
+
+    /// State at time `t` (s), exact.
+    #[must_use]
+    pub fn output_at(&self, t: f64) -> ObstacleOutput {
+        match self.shape {
+            ObstacleShape::Circle { diameter } => ObstacleOutput {
+                x: self.x,
+                y: self.y,
+                psi: 0.0,
+                speed: 0.0,
+                length: diameter,
+                width: diameter,
+                kind: KIND_CIRCLE,
+            },
+            ObstacleShape::Vessel {
+                length,
+                width,
+                course,
+                speed,
+                activation_time,
+            } => {
+                if t >= activation_time {
+                    let run = speed * (t - activation_time);
+                    let (s, c) = course.sin_cos();
+                    ObstacleOutput {
+                        x: self.x + run * c,
+                        y: self.y + run * s,
+                        psi: course,
+                        speed,
+                        length,
+                        width,
+                        kind: KIND_VESSEL,
+                    }
+                } else {
+                    ObstacleOutput {
+                        x: self.x,
+                        y: self.y,
+                        psi: course,
+                        speed: 0.0,
+                        length,
+                        width,
+                        kind: KIND_NONE,
+                    }
+                }
+            }
+        }
+    }
+
+    /// Checks the values (paths relative to the obstacle, as in the scenario file):
+    /// finite position, diameter / length / width > 0, width <= length, course
+    /// finite, speed >= 0, activation time >= 0.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        use crate::vessel::{check_finite, check_non_negative, check_positive};
+        if self.name.trim().is_empty() {
+            return Err(ParamError::new("name", "must not be empty"));
+        }
+        check_finite("x", self.x)?;
+        check_finite("y", self.y)?;
+        match self.shape {
+            ObstacleShape::Circle { diameter } => check_positive("diameter", diameter, "m")?,
+            ObstacleShape::Vessel {
+                length,
+                width,
+                course,
+                speed,
+                activation_time,
+            } => {
+                check_positive("length", length, "m")?;
+                check_positive("width", width, "m")?;
+                if width > length {
+                    return Err(ParamError::new(
+                        "width",
+                        format!(
+                            "must not exceed length ({length} m; length is the ellipse's major axis), got {width} m"
+                        ),
+                    ));
+                }
+                check_finite("course_deg", course)?;
+                check_non_negative("speed", speed, "m/s")?;
+                check_non_negative("activation_time", activation_time, "s")?;
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn target(activation_time: f64) -> Obstacle {
+        Obstacle {
+            name: "B".into(),
+            x: -22.0,
+            y: 40.75,
+            shape: ObstacleShape::Vessel {
+                length: 1.48,
+                width: 0.48,
+                course: 0.0,
+                speed: 0.07,
+                activation_time,
+            },
+        }
+    }
+
+    #[test]
+    fn target_ship_is_inactive_before_activation_and_moves_exactly_after() {
+        let b = target(405.0);
+        let before = b.output_at(404.9);
+        assert_eq!(before.kind, KIND_NONE);
+        assert_eq!((before.x, before.y, before.speed), (-22.0, 40.75, 0.0));
+        assert_eq!((before.length, before.width), (1.48, 0.48));
+        let at = b.output_at(405.0);
+        assert_eq!(at.kind, KIND_VESSEL);
+        assert_eq!((at.x, at.y), (-22.0, 40.75));
+        let later = b.output_at(505.0);
+        assert!((later.x - (-22.0 + 7.0)).abs() < 1e-12);
+        assert!((later.y - 40.75).abs() < 1e-12);
+        assert_eq!(later.speed, 0.07);
+        assert!(!b.is_active(0.0) && b.is_active(405.0));
+    }
+
+    #[test]
+    fn course_east_moves_east() {
+        let mut o = target(0.0);
+        if let ObstacleShape::Vessel { course, .. } = &mut o.shape {
+            *course = std::f64::consts::FRAC_PI_2;
+        }
+        let out = o.output_at(10.0);
+        assert!((out.x + 22.0).abs() < 1e-12 && (out.y - 41.45).abs() < 1e-12);
+        assert_eq!(out.psi, std::f64::consts::FRAC_PI_2);
+    }
+
+    #[test]
+    fn static_circle_reports_its_diameter() {
+        let a = Obstacle {
+            name: "a".into(),
+            x: -10.0,
+            y: 15.0,
+            shape: ObstacleShape::Circle { diameter: 1.0 },
+        };
+        let out = a.output_at(1234.0);
+        assert_eq!(
+            out,
+            ObstacleOutput {
+                x: -10.0,
+                y: 15.0,
+                psi: 0.0,
+                speed: 0.0,
+                length: 1.0,
+                width: 1.0,
+                kind: KIND_CIRCLE
+            }
+        );
+    }
+
+    #[test]
+    fn validation() {
+        let mut o = target(0.0);
+        if let ObstacleShape::Vessel { width, .. } = &mut o.shape {
+            *width = 2.0;
+        }
+        assert_eq!(o.validate().unwrap_err().field, "width");
+        let mut o = target(0.0);
+        if let ObstacleShape::Vessel { speed, .. } = &mut o.shape {
+            *speed = -0.1;
+        }
+        assert_eq!(o.validate().unwrap_err().field, "speed");
+        let mut o = target(0.0);
+        if let ObstacleShape::Vessel {
+            activation_time, ..
+        } = &mut o.shape
+        {
+            *activation_time = -1.0;
+        }
+        assert_eq!(o.validate().unwrap_err().field, "activation_time");
+    }
+}

@@ -1,0 +1,43 @@
+"""Logger callbacks for fmpy that keep an FMU's log messages for inspection.
+
+fmpy's own default logger prints; tests and masters want the messages as data (an FMU's
+error message is how it says what went wrong). The variadic FMI logger is turned into a
+plain one by fmpy's logger proxy, which formats the message with vsnprintf.
+"""
+
+from ctypes import byref
+
+from fmpy.fmi1 import calloc, free
+from fmpy.fmi2 import (
+    fmi2CallbackAllocateMemoryTYPE,
+    fmi2CallbackFreeMemoryTYPE,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+)
+from fmpy.logging import addLoggerProxy
+
+STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
+
+
+class MessageLog:
+    """Collects (status, category, message) tuples from one or more FMU instances."""
+
+    def __init__(self, echo=False):
+        self.messages = []
+        self.echo = echo
+        self._logger = fmi2CallbackLoggerTYPE(self._log)
+        self.callbacks = fmi2CallbackFunctions()
+        self.callbacks.logger = self._logger
+        self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        addLoggerProxy(byref(self.callbacks))
+
+    def _log(self, env, instance, status, category, message):
+        entry = (STATUS[status], category.decode(), message.decode("utf-8", "replace"))
+        self.messages.append(entry)
+        if self.echo:
+            print(f"[{entry[0]}] {instance.decode()}: {entry[2]}")
+
+    def text(self, min_status="OK"):
+        level = STATUS.index(min_status)
+        return "\n".join(m for s, _, m in self.messages if STATUS.index(s) >= level)

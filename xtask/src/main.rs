@@ -1,0 +1,232 @@
+//! Build automation for the towing co-simulation workspace.
+//!
+//! ```text
+//! cargo xtask fmu                 build release libraries, package target/fmu/<Model>.fmu
+//! cargo xtask model-description   regenerate modelDescription/<Model>.xml from the Rust tables
+//! cargo xtask python              create/refresh the Python environment in .venv
+//! cargo xtask test                the README's test command: everything CI checks
+//! cargo xtask demo                the README's main command
+//! ```
+//!
+//! Every step prints what it does; a failing step names itself and the reason.
+
+use std::fmt;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+
+mod fmu;
+mod python;
+
+/// One FMU of the workspace: the crate that builds it and its identifiers.
+#[derive(Debug, Clone, Copy)]
+pub struct FmuCrate {
+    /// Cargo package name.
+    pub package: &'static str,
+    /// `[lib] name` of the package, i.e. the stem of `lib<name>.so`.
+    pub lib_name: &'static str,
+    /// FMI modelIdentifier: the binary name inside the FMU and the FMU's file name.
+    pub model_identifier: &'static str,
+    /// Files copied into the FMU's `resources/` folder (repository-relative source, name inside).
+    pub resources: &'static [(&'static str, &'static str)],
+}
+
+/// The FMUs `cargo xtask fmu` packages.
+pub const FMUS: &[FmuCrate] = &[FmuCrate {
+    package: "fmu-plant",
+    lib_name: "towing_plant",
+    model_identifier: "TowingPlant",
+    resources: &[("scenarios/paper.toml", "paper.toml")],
+}];
+
+/// Error of one xtask step: which step failed and why.
+#[derive(Debug)]
+pub struct StepError {
+    pub step: String,
+    pub reason: String,
+}
+
+impl fmt::Display for StepError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "step '{}' failed: {}", self.step, self.reason)
+    }
+}
+
+pub type Result<T> = std::result::Result<T, StepError>;
+
+pub fn fail<T>(step: &str, reason: impl Into<String>) -> Result<T> {
+    Err(StepError {
+        step: step.to_owned(),
+        reason: reason.into(),
+    })
+}
+
+/// Repository root (the workspace directory).
+pub fn root() -> PathBuf {
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    manifest.parent().unwrap_or(manifest).to_path_buf()
+}
+
+/// The shared cargo target directory.
+pub fn target_dir() -> PathBuf {
+    match std::env::var_os("CARGO_TARGET_DIR") {
+        Some(dir) => {
+            let dir = PathBuf::from(dir);
+            if dir.is_absolute() {
+                dir
+            } else {
+                root().join(dir)
+            }
+        }
+        None => root().join("target"),
+    }
+}
+
+/// Prints a progress line (xtask is a terminal program; progress goes to stderr).
+pub fn progress(message: &str) {
+    let mut err = std::io::stderr().lock();
+    let _ = writeln!(err, "xtask: {message}");
+}
+
+/// Runs a command in the repository root, streaming its output; fails the step on non-zero exit.
+pub fn run(step: &str, cmd: &mut Command) -> Result<()> {
+    progress(&format!("{step}: {}", describe(cmd)));
+    let status = cmd.current_dir(root()).status().map_err(|e| StepError {
+        step: step.to_owned(),
+        reason: format!("could not start {}: {e}", describe(cmd)),
+    })?;
+    if status.success() {
+        Ok(())
+    } else {
+        fail(step, format!("{} exited with {status}", describe(cmd)))
+    }
+}
+
+/// Runs a command and returns its standard output (standard error is passed through).
+pub fn output(step: &str, cmd: &mut Command) -> Result<String> {
+    let out = cmd
+        .current_dir(root())
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .map_err(|e| StepError {
+            step: step.to_owned(),
+            reason: format!("could not start {}: {e}", describe(cmd)),
+        })?;
+    if !out.status.success() {
+        return fail(
+            step,
+            format!("{} exited with {}", describe(cmd), out.status),
+        );
+    }
+    String::from_utf8(out.stdout).or_else(|_| fail(step, "output is not UTF-8"))
+}
+
+fn describe(cmd: &Command) -> String {
+    let mut s = cmd.get_program().to_string_lossy().into_owned();
+    for a in cmd.get_args() {
+        s.push(' ');
+        s.push_str(&a.to_string_lossy());
+    }
+    s
+}
+
+pub fn cargo() -> Command {
+    Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
+}
+
+const USAGE: &str = "usage: cargo xtask <command>
+
+commands:
+  fmu                 build the release libraries and write target/fmu/<Model>.fmu
+  model-description   regenerate modelDescription/<Model>.xml from the Rust variable tables
+  python              create or refresh the Python environment (.venv) with fmpy and libcosimpy
+  test                run every check CI runs (fmt, clippy, FMU packaging, Rust and Python tests)
+  demo                package the plant and run it under fmpy (writes out/plant-demo/)";
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let result = match args.first().map(String::as_str) {
+        Some("fmu") => fmu::package_all().map(|_| ()),
+        Some("model-description") => fmu::write_model_descriptions(),
+        Some("python") => python::ensure_env().map(|_| ()),
+        Some("test") => test_all(),
+        Some("demo") => demo(),
+        Some("-h" | "--help" | "help") => {
+            progress(USAGE);
+            Ok(())
+        }
+        other => {
+            progress(&format!("unknown command {other:?}\n{USAGE}"));
+            return ExitCode::from(2);
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            progress(&format!("error: {e}"));
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The README's test command: formatting, lints, packaging, Rust tests, Python tests.
+fn test_all() -> Result<()> {
+    let python = python::ensure_env()?;
+    run(
+        "format check",
+        cargo().args(["fmt", "--all", "--", "--check"]),
+    )?;
+    run(
+        "clippy",
+        cargo().args([
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--release",
+            "--",
+            "-D",
+            "warnings",
+        ]),
+    )?;
+    fmu::package_all()?;
+    run(
+        "rust tests",
+        cargo().args(["test", "--workspace", "--release", "--no-fail-fast"]),
+    )?;
+    run(
+        "python tests",
+        Command::new(&python).args(["-m", "pytest", "tests/python", "-q", "-ra"]),
+    )?;
+    progress("all checks passed");
+    Ok(())
+}
+
+/// The README's main command (for now: the plant alone under fmpy with a constant input).
+fn demo() -> Result<()> {
+    let python = python::ensure_env()?;
+    let fmus = fmu::package_all()?;
+    let plant = fmus
+        .iter()
+        .find(|p| p.ends_with("TowingPlant.fmu"))
+        .cloned()
+        .ok_or_else(|| StepError {
+            step: "demo".into(),
+            reason: "TowingPlant.fmu was not packaged".into(),
+        })?;
+    let out = root().join("out/plant-demo");
+    run(
+        "plant demo under fmpy",
+        Command::new(&python)
+            .arg("masters/plant_demo.py")
+            .arg("--fmu")
+            .arg(&plant)
+            .arg("--out")
+            .arg(&out),
+    )?;
+    progress(&format!(
+        "demo finished: {} and {}",
+        out.join("track.csv").display(),
+        out.join("track.png").display()
+    ));
+    Ok(())
+}
