@@ -13,6 +13,7 @@ use zip::write::SimpleFileOptions;
 struct Generated {
     xml: String,
     html: String,
+    markdown: String,
 }
 
 fn generate(fmu: &FmuCrate) -> Result<Generated> {
@@ -36,6 +37,7 @@ fn generate(fmu: &FmuCrate) -> Result<Generated> {
     Ok(Generated {
         xml: run_example("xml")?,
         html: run_example("html")?,
+        markdown: run_example("markdown")?,
     })
 }
 
@@ -45,20 +47,42 @@ fn committed_path(fmu: &FmuCrate) -> PathBuf {
         .join(format!("{}.xml", fmu.model_identifier))
 }
 
-/// `cargo xtask model-description`: rewrites the committed model descriptions.
+/// `cargo xtask model-description`: rewrites the committed model descriptions and the
+/// generated variable tables of `docs/interface.md`.
 pub fn write_model_descriptions() -> Result<()> {
+    const STEP: &str = "write model description";
+    let doc_path = root().join("docs/interface.md");
+    let mut doc = std::fs::read_to_string(&doc_path)
+        .or_else(|e| fail(STEP, format!("{}: {e}", doc_path.display())))?;
     for fmu in FMUS {
         let generated = generate(fmu)?;
         let path = committed_path(fmu);
-        std::fs::write(&path, &generated.xml).or_else(|e| {
-            fail(
-                "write model description",
-                format!("{}: {e}", path.display()),
-            )
-        })?;
+        std::fs::write(&path, &generated.xml)
+            .or_else(|e| fail(STEP, format!("{}: {e}", path.display())))?;
         progress(&format!("wrote {}", path.display()));
+        doc = splice(&doc, fmu.model_identifier, &generated.markdown)
+            .or_else(|e| fail(STEP, format!("{}: {e}", doc_path.display())))?;
     }
+    std::fs::write(&doc_path, doc)
+        .or_else(|e| fail(STEP, format!("{}: {e}", doc_path.display())))?;
+    progress(&format!("wrote {}", doc_path.display()));
     Ok(())
+}
+
+/// Replaces the text between `<!-- BEGIN GENERATED: <id> variables -->` and the matching END
+/// marker with `table`.
+fn splice(doc: &str, id: &str, table: &str) -> std::result::Result<String, String> {
+    let begin = format!("<!-- BEGIN GENERATED: {id} variables -->\n");
+    let end = format!("<!-- END GENERATED: {id} variables -->");
+    let a = doc
+        .find(&begin)
+        .ok_or_else(|| format!("marker {begin:?} not found"))?
+        + begin.len();
+    let b = doc[a..]
+        .find(&end)
+        .ok_or_else(|| format!("marker {end:?} not found"))?
+        + a;
+    Ok(format!("{}{table}{}", &doc[..a], &doc[b..]))
 }
 
 /// `cargo xtask fmu`: builds and packages every FMU; returns the paths of the .fmu files.

@@ -52,7 +52,7 @@ pub fn variables_markdown(md: &ModelDescription) -> String {
     for v in &md.variables {
         out.push_str(&format!(
             "| `{}` | {} | {} | {} | {} | {} | {} | {} |\n",
-            v.name,
+            md_escape(&v.name),
             v.causality.as_str(),
             v.variability.as_str(),
             v.kind.value_type().as_str(),

@@ -58,6 +58,7 @@ pub mod ffi;
 mod logger;
 mod serial;
 mod state;
+pub mod testing;
 mod uri;
 
 use std::path::Path;

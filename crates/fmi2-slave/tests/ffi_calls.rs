@@ -11,6 +11,7 @@ use std::ptr;
 
 use common::*;
 use fmi2_slave::ffi::*;
+use fmi2_slave::testing::{callbacks, Capture, Fmu};
 use fmi2_slave::Fmi2Status;
 
 const ERROR: c_int = Fmi2Status::Error as c_int;
@@ -27,7 +28,7 @@ fn assert_logged(fmu: &Fmu, status: Fmi2Status, fragment: &str) {
 /// A fresh instance driven into `state` ("instantiated", "initializationMode",
 /// "stepComplete", "stepFailed", "terminated", "error").
 fn fresh_in(state: &str) -> Fmu {
-    let f = Fmu::new("in_state");
+    let f = new_fmu("in_state");
     unsafe {
         match state {
             "instantiated" => {}
@@ -384,7 +385,7 @@ fn instantiate_passes_decoded_resource_dir_and_accepts_null_memory_callbacks() {
     }
     uri.push('/');
     assert!(uri.contains("%20") && uri.contains("%C3%A6"), "{uri}");
-    let fmu = Fmu::try_new("with_resources", Some(&uri), true).unwrap();
+    let fmu = try_fmu("with_resources", Some(&uri), true).unwrap();
     let want = format!("instantiated with resources at {:?}", Some(dir.path()));
     let msgs = fmu.messages();
     assert!(
@@ -569,7 +570,7 @@ fn null_arrays_and_outputs_are_errors_unless_empty() {
 
 #[test]
 fn illegal_call_sequence_is_logged_and_enters_the_error_state() {
-    let fmu = Fmu::new("seq");
+    let fmu = new_fmu("seq");
     unsafe {
         assert_eq!(fmu.step(0.0, 0.1), Fmi2Status::Error);
         let m = fmu.messages();
@@ -874,7 +875,7 @@ fn warnings_are_always_logged_with_percent_s_and_nul_replaced() {
 
 #[test]
 fn info_needs_logging_on_and_an_enabled_category() {
-    let f = Fmu::logging("dbg");
+    let f = logging_fmu("dbg");
     assert!(f
         .messages()
         .iter()

@@ -11,6 +11,7 @@ use std::ptr;
 
 use common::*;
 use fmi2_slave::ffi::*;
+use fmi2_slave::testing::Fmu;
 use fmi2_slave::Fmi2Status;
 
 /// The model's own arithmetic, replicated: Euler substeps of y' = (u - y) / T.
@@ -25,7 +26,7 @@ fn reference_step(y: f64, u: f64, t_const: f64, h: f64, substeps: i32) -> f64 {
 
 #[test]
 fn clock_counts_nanoseconds_and_does_not_drift() {
-    let f = Fmu::new("clock");
+    let f = new_fmu("clock");
     assert_eq!(f.set_real(R_U, 1.0), Fmi2Status::Ok);
     f.init(0.0, Some(100.0));
     let mut t_master = 0.0; // accumulated like a naive master: drifts in the last bits
@@ -57,7 +58,7 @@ fn clock_counts_nanoseconds_and_does_not_drift() {
 
 #[test]
 fn start_time_offsets_the_clock() {
-    let f = Fmu::new("start");
+    let f = new_fmu("start");
     f.init(5.0, None);
     assert_eq!(f.last_successful_time(), 5.0);
     assert_eq!(f.step(5.0, 0.25), Fmi2Status::Ok);
@@ -131,7 +132,7 @@ fn do_step_rejects_bad_arguments_with_the_numbers() {
         (None, 0.0, 1e12, "overflows the FMU's nanosecond clock"),
     ];
     for (stop, t, h, fragment) in cases {
-        let f = Fmu::new("bad_step");
+        let f = new_fmu("bad_step");
         f.init(0.0, stop);
         assert_eq!(f.step(t, h), Fmi2Status::Error, "t = {t}, h = {h}");
         let text = f.last_text();
@@ -144,7 +145,7 @@ fn do_step_rejects_bad_arguments_with_the_numbers() {
         );
     }
     // within tolerance of the stop time and of the clock: accepted
-    let f = Fmu::new("edge");
+    let f = new_fmu("edge");
     f.init(0.0, Some(1.0));
     assert_eq!(f.step(1e-6, 1.0 + 1e-6), Fmi2Status::Ok);
 }
@@ -167,7 +168,7 @@ fn setup_experiment_rejects_bad_times() {
             "tolerance = -0.000001 must be finite and >= 0",
         ),
     ] {
-        let f = Fmu::new("setup");
+        let f = new_fmu("setup");
         let status = unsafe {
             fmi2SetupExperiment(
                 f.c,
@@ -189,7 +190,7 @@ fn setup_experiment_rejects_bad_times() {
 
 #[test]
 fn warning_advances_time_discard_does_not_error_stops() {
-    let f = Fmu::new("outcomes");
+    let f = new_fmu("outcomes");
     f.init(0.0, None);
     for k in 0..3 {
         assert_eq!(f.step(f64::from(k) * 0.1, 0.1), Fmi2Status::Ok);
@@ -237,12 +238,13 @@ fn warning_advances_time_discard_does_not_error_stops() {
         Fmi2Status::Warning,
         "fault_mode restored to 1"
     );
-    f.free_state(before);
+    // SAFETY: a live state of this instance, freed once.
+    unsafe { f.free_state(before) };
 }
 
 #[test]
 fn discard_then_terminate_is_allowed() {
-    let f = Fmu::new("discard_terminate");
+    let f = new_fmu("discard_terminate");
     f.init(0.0, None);
     assert_eq!(f.set_integer(I_FAULT, FAULT_DISCARD), Fmi2Status::Ok);
     assert_eq!(f.step(0.0, 0.1), Fmi2Status::Discard);
@@ -260,7 +262,7 @@ fn discard_then_terminate_is_allowed() {
 
 #[test]
 fn fmu_state_restores_model_and_layer_and_is_overwritten_in_place() {
-    let f = Fmu::new("state");
+    let f = new_fmu("state");
     assert_eq!(f.set_real(R_U, 2.0), Fmi2Status::Ok);
     f.init(0.0, None);
     let run = |from: usize, n: usize| -> Vec<u64> {
@@ -293,12 +295,13 @@ fn fmu_state_restores_model_and_layer_and_is_overwritten_in_place() {
     assert_eq!(f.step(1.3, 0.1), Fmi2Status::Error);
     unsafe { assert_eq!(fmi2SetFMUstate(f.c, s), Fmi2Status::Ok) };
     assert_eq!(run(10, 1), after[..1]);
-    f.free_state(s);
+    // SAFETY: a live state of this instance, freed once.
+    unsafe { f.free_state(s) };
 }
 
 #[test]
 fn serialized_state_continues_bit_identically_in_a_fresh_instance() {
-    let a = Fmu::new("a");
+    let a = new_fmu("a");
     assert_eq!(a.set_real(R_T, 0.7), Fmi2Status::Ok);
     assert_eq!(a.set_integer(I_SUBSTEPS, 3), Fmi2Status::Ok);
     let label = std::ffi::CString::new("serialized ✓").unwrap();
@@ -316,11 +319,12 @@ fn serialized_state_continues_bit_identically_in_a_fresh_instance() {
     let bytes = a.serialize();
     assert_eq!(&bytes[..8], b"RSFMI2ST");
 
-    let b = Fmu::new("b"); // only instantiated
+    let b = new_fmu("b"); // only instantiated
     let (status, s) = b.deserialize(&bytes);
     assert_eq!(status, Fmi2Status::Ok, "{:?}", b.messages());
     unsafe { assert_eq!(fmi2SetFMUstate(b.c, s), Fmi2Status::Ok) };
-    b.free_state(s);
+    // SAFETY: a live state of this instance, freed once.
+    unsafe { b.free_state(s) };
     assert_eq!(b.last_successful_time(), a.last_successful_time());
     assert_eq!(b.get_integer(I_STEPS), 17);
     let mut p: *const c_char = ptr::null();
@@ -347,7 +351,7 @@ fn serialized_state_continues_bit_identically_in_a_fresh_instance() {
 
 #[test]
 fn deserialize_names_what_does_not_match() {
-    let a = Fmu::new("src");
+    let a = new_fmu("src");
     a.init(0.0, None);
     assert_eq!(a.step(0.0, 0.1), Fmi2Status::Ok);
     let good = a.serialize();
@@ -382,7 +386,7 @@ fn deserialize_names_what_does_not_match() {
     model[model_at] = 9;
     cases.push((model, "model state: Lag state: bad version"));
 
-    let b = Fmu::new("dst");
+    let b = new_fmu("dst");
     for (bytes, fragment) in cases {
         let (status, s) = b.deserialize(&bytes);
         assert_eq!(status, Fmi2Status::Error, "{fragment}");
@@ -394,12 +398,13 @@ fn deserialize_names_what_does_not_match() {
     }
     let (status, s) = b.deserialize(&good);
     assert_eq!(status, Fmi2Status::Ok);
-    b.free_state(s);
+    // SAFETY: a live state of this instance, freed once.
+    unsafe { b.free_state(s) };
 }
 
 #[test]
 fn serialize_requires_the_reported_size() {
-    let f = Fmu::new("size");
+    let f = new_fmu("size");
     f.init(0.0, None);
     let s = f.get_state();
     let mut size = 0usize;
@@ -424,12 +429,13 @@ fn serialize_requires_the_reported_size() {
         );
         assert_eq!(buf[size], 0, "nothing written past size");
     }
-    f.free_state(s);
+    // SAFETY: a live state of this instance, freed once.
+    unsafe { f.free_state(s) };
 }
 
 #[test]
 fn deserialize_overwrites_an_existing_state_in_place() {
-    let f = Fmu::new("inplace");
+    let f = new_fmu("inplace");
     f.init(0.0, None);
     assert_eq!(f.set_real(R_U, 1.0), Fmi2Status::Ok);
     assert_eq!(f.step(0.0, 0.1), Fmi2Status::Ok);
@@ -448,12 +454,13 @@ fn deserialize_overwrites_an_existing_state_in_place() {
     }
     assert_eq!(f.get_real(R_Y), y1);
     assert_eq!(f.last_successful_time(), 0.1);
-    f.free_state(s);
+    // SAFETY: a live state of this instance, freed once.
+    unsafe { f.free_state(s) };
 }
 
 #[test]
 fn reset_restores_start_values_and_keeps_debug_logging_settings() {
-    let f = Fmu::logging("reset");
+    let f = logging_fmu("reset");
     assert_eq!(f.set_real(R_T, 3.0), Fmi2Status::Ok);
     assert_eq!(f.set_real(R_U, 1.0), Fmi2Status::Ok);
     f.init(2.0, Some(3.0));
@@ -486,7 +493,7 @@ fn reset_restores_start_values_and_keeps_debug_logging_settings() {
 
 #[test]
 fn status_queries_follow_the_standard() {
-    let f = Fmu::new("status");
+    let f = new_fmu("status");
     f.init(0.0, None);
     let mut st = Fmi2Status::Ok;
     let mut i: c_int = -1;
@@ -548,7 +555,7 @@ fn unsupported_functions_log_and_return_error() {
         ),
     ];
     for (call, text) in cases {
-        let f = Fmu::new("unsupported");
+        let f = new_fmu("unsupported");
         f.init(0.0, None);
         assert_eq!(call(&f), Fmi2Status::Error, "{text}");
         assert_eq!(f.last_text(), text);
@@ -575,10 +582,10 @@ fn eight_instances_on_eight_threads_match_sequential_runs() {
     let t_consts: Vec<f64> = (0..N).map(|i| 0.1 + 0.3 * i as f64).collect();
     let sequential: Vec<Vec<u64>> = t_consts
         .iter()
-        .map(|&tc| trajectory(&Fmu::new("seq"), tc, STEPS))
+        .map(|&tc| trajectory(&new_fmu("seq"), tc, STEPS))
         .collect();
     // instances created on this thread, each stepped on its own thread (as libcosim does)
-    let instances: Vec<Fmu> = (0..N).map(|i| Fmu::new(&format!("par{i}"))).collect();
+    let instances: Vec<Fmu> = (0..N).map(|i| new_fmu(&format!("par{i}"))).collect();
     let concurrent: Vec<Vec<u64>> = std::thread::scope(|scope| {
         let handles: Vec<_> = instances
             .into_iter()

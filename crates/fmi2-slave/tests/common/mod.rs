@@ -1,15 +1,16 @@
-//! Test model and FFI harness shared by the integration tests.
+//! Test model shared by the integration tests, and the `fmi2_slave::testing` harness bound to
+//! it.
 //!
 //! Each test binary invokes `fmi2_slave::export_fmi2!(common::Lag)` at its root, so the 34
-//! `fmi2*` functions exist as `crate::fmi2*` and are called here exactly as a master would.
-#![allow(dead_code, clippy::unwrap_used, clippy::missing_safety_doc)]
+//! `fmi2*` functions exist as `crate::fmi2*`; [`exports`] collects them and the constructors
+//! below instantiate [`Lag`] through them exactly as a master would.
+#![allow(dead_code, clippy::unwrap_used)]
 
-use std::ffi::{c_char, c_int, c_void, CStr, CString};
+use std::ffi::CString;
 use std::path::PathBuf;
-use std::ptr;
-use std::sync::{LazyLock, Mutex};
+use std::sync::LazyLock;
 
-use fmi2_slave::ffi::*;
+use fmi2_slave::testing::{Exports, Fmu, Msg};
 use fmi2_slave::{
     BaseUnit, Causality, DefaultExperiment, Fmi2Model, Initial, InstanceContext, LogCategory,
     Logger, ModelDescription, StepContext, StepOutcome, UnitDefinition, Variability, Variable,
@@ -327,270 +328,29 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
     }
 }
 
-// ---- logger capture -------------------------------------------------------------------
+// ---- the harness, bound to this test binary's exports ---------------------------------
 
-#[derive(Debug, Clone, PartialEq)]
-pub struct Msg {
-    pub instance: String,
-    pub status: c_int,
-    pub category: String,
-    pub format: String,
-    pub text: String,
+/// The functions `export_fmi2!(common::Lag)` generated at the root of the test binary.
+pub fn exports() -> Exports {
+    fmi2_slave::exports_of!(crate)
 }
 
-#[derive(Debug, Default)]
-pub struct Capture {
-    pub messages: Mutex<Vec<Msg>>,
-}
-
-unsafe fn lossy(p: *const c_char) -> String {
-    if p.is_null() {
-        "<NULL>".into()
-    } else {
-        unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
-    }
-}
-
-/// Receives exactly the arguments the layer passes: format plus one `char*`.
-unsafe extern "C" fn capture_logger(
-    env: *mut c_void,
-    instance: *const c_char,
-    status: c_int,
-    category: *const c_char,
-    format: *const c_char,
-    arg: *const c_char,
-) {
-    let capture = unsafe { &*env.cast::<Capture>() };
-    let msg = unsafe {
-        Msg {
-            instance: lossy(instance),
-            status,
-            category: lossy(category),
-            format: lossy(format),
-            text: lossy(arg),
-        }
-    };
-    capture
-        .messages
-        .lock()
-        .unwrap_or_else(|e| e.into_inner())
-        .push(msg);
-}
-
-/// The logger as the C-variadic `fmi2CallbackLogger`.
-///
-/// Stable Rust cannot define a variadic function, so the test defines a function with one
-/// fixed `char*` in the vararg position. On the targets this project builds for (x86_64
-/// SysV and Windows x64, aarch64 Linux) a single pointer vararg is passed exactly like a
-/// sixth fixed pointer argument, so the call the layer makes reaches it intact. (Not valid
-/// on Apple arm64, where varargs go on the stack.)
-pub fn logger_fn() -> Fmi2CallbackLogger {
-    type Fixed = unsafe extern "C" fn(
-        *mut c_void,
-        *const c_char,
-        c_int,
-        *const c_char,
-        *const c_char,
-        *const c_char,
-    );
-    unsafe { std::mem::transmute::<Fixed, Fmi2CallbackLogger>(capture_logger as Fixed) }
-}
-
-pub fn callbacks(capture: &Capture) -> Fmi2CallbackFunctions {
-    Fmi2CallbackFunctions {
-        logger: Some(logger_fn()),
-        allocate_memory: None,
-        free_memory: None,
-        step_finished: None,
-        component_environment: ptr::from_ref(capture).cast_mut().cast(),
-    }
-}
-
+/// The GUID of [`DESCRIPTION`] as a C string.
 pub fn guid() -> CString {
     CString::new(DESCRIPTION.guid()).unwrap()
 }
 
-// ---- an instance as a master sees it ------------------------------------------------------
-
-/// An instance with its own logger capture; freed on drop.
-pub struct Fmu {
-    pub c: Fmi2Component,
-    pub capture: Box<Capture>,
+/// Instantiates the test model (co-simulation, [`DESCRIPTION`]'s GUID); the log on failure.
+pub fn try_fmu(name: &str, uri: Option<&str>, logging_on: bool) -> Result<Fmu, Vec<Msg>> {
+    Fmu::try_new(exports(), &DESCRIPTION, name, uri, logging_on)
 }
 
-// FMI allows an instance to be called from any thread as long as calls do not overlap
-// (libcosim steps on pool threads); the capture is a Mutex.
-unsafe impl Send for Fmu {}
-
-impl Fmu {
-    pub fn try_new(name: &str, uri: Option<&str>, logging_on: bool) -> Result<Fmu, Vec<Msg>> {
-        let capture = Box::<Capture>::default();
-        let functions = callbacks(&capture);
-        let name = CString::new(name).unwrap();
-        let uri = uri.map(|u| CString::new(u).unwrap());
-        let c = unsafe {
-            crate::fmi2Instantiate(
-                name.as_ptr(),
-                FMI2_CO_SIMULATION,
-                guid().as_ptr(),
-                uri.as_ref().map_or(ptr::null(), |u| u.as_ptr()),
-                &functions,
-                FMI2_FALSE,
-                c_int::from(logging_on),
-            )
-        };
-        if c.is_null() {
-            Err(capture.messages.lock().unwrap().clone())
-        } else {
-            Ok(Fmu { c, capture })
-        }
-    }
-
-    pub fn new(name: &str) -> Fmu {
-        Self::try_new(name, None, false).unwrap()
-    }
-
-    pub fn logging(name: &str) -> Fmu {
-        Self::try_new(name, None, true).unwrap()
-    }
-
-    pub fn messages(&self) -> Vec<Msg> {
-        self.capture.messages.lock().unwrap().clone()
-    }
-
-    pub fn clear(&self) {
-        self.capture.messages.lock().unwrap().clear();
-    }
-
-    pub fn last_text(&self) -> String {
-        self.messages()
-            .last()
-            .map(|m| m.text.clone())
-            .unwrap_or_default()
-    }
-
-    pub fn setup(&self, start: f64, stop: Option<f64>) -> Fmi2Status {
-        unsafe {
-            crate::fmi2SetupExperiment(
-                self.c,
-                FMI2_FALSE,
-                0.0,
-                start,
-                c_int::from(stop.is_some()),
-                stop.unwrap_or(0.0),
-            )
-        }
-    }
-
-    /// SetupExperiment(start, stop), Enter/ExitInitializationMode, all expected OK.
-    pub fn init(&self, start: f64, stop: Option<f64>) {
-        assert_eq!(self.setup(start, stop), Fmi2Status::Ok);
-        assert_eq!(
-            unsafe { crate::fmi2EnterInitializationMode(self.c) },
-            Fmi2Status::Ok
-        );
-        assert_eq!(
-            unsafe { crate::fmi2ExitInitializationMode(self.c) },
-            Fmi2Status::Ok
-        );
-    }
-
-    pub fn step(&self, t: f64, h: f64) -> Fmi2Status {
-        unsafe { crate::fmi2DoStep(self.c, t, h, FMI2_TRUE) }
-    }
-
-    pub fn get_real(&self, vr: u32) -> f64 {
-        let mut v = f64::NAN;
-        assert_eq!(
-            unsafe { crate::fmi2GetReal(self.c, &vr, 1, &mut v) },
-            Fmi2Status::Ok
-        );
-        v
-    }
-
-    pub fn try_get_real(&self, vr: u32) -> (Fmi2Status, f64) {
-        let mut v = f64::NAN;
-        let s = unsafe { crate::fmi2GetReal(self.c, &vr, 1, &mut v) };
-        (s, v)
-    }
-
-    pub fn set_real(&self, vr: u32, value: f64) -> Fmi2Status {
-        unsafe { crate::fmi2SetReal(self.c, &vr, 1, &value) }
-    }
-
-    pub fn get_integer(&self, vr: u32) -> i32 {
-        let mut v = -1;
-        assert_eq!(
-            unsafe { crate::fmi2GetInteger(self.c, &vr, 1, &mut v) },
-            Fmi2Status::Ok
-        );
-        v
-    }
-
-    pub fn set_integer(&self, vr: u32, value: i32) -> Fmi2Status {
-        unsafe { crate::fmi2SetInteger(self.c, &vr, 1, &value) }
-    }
-
-    pub fn set_boolean(&self, vr: u32, value: bool) -> Fmi2Status {
-        let v = c_int::from(value);
-        unsafe { crate::fmi2SetBoolean(self.c, &vr, 1, &v) }
-    }
-
-    pub fn last_successful_time(&self) -> f64 {
-        let mut t = f64::NAN;
-        assert_eq!(
-            unsafe { crate::fmi2GetRealStatus(self.c, FMI2_LAST_SUCCESSFUL_TIME, &mut t) },
-            Fmi2Status::Ok
-        );
-        t
-    }
-
-    pub fn get_state(&self) -> Fmi2FmuState {
-        let mut s: Fmi2FmuState = ptr::null_mut();
-        assert_eq!(
-            unsafe { crate::fmi2GetFMUstate(self.c, &mut s) },
-            Fmi2Status::Ok
-        );
-        assert!(!s.is_null());
-        s
-    }
-
-    pub fn free_state(&self, mut s: Fmi2FmuState) {
-        assert_eq!(
-            unsafe { crate::fmi2FreeFMUstate(self.c, &mut s) },
-            Fmi2Status::Ok
-        );
-        assert!(s.is_null());
-    }
-
-    pub fn serialize(&self) -> Vec<u8> {
-        let s = self.get_state();
-        let mut size = 0usize;
-        assert_eq!(
-            unsafe { crate::fmi2SerializedFMUstateSize(self.c, s, &mut size) },
-            Fmi2Status::Ok
-        );
-        let mut bytes = vec![0u8; size];
-        assert_eq!(
-            unsafe { crate::fmi2SerializeFMUstate(self.c, s, bytes.as_mut_ptr().cast(), size) },
-            Fmi2Status::Ok
-        );
-        self.free_state(s);
-        bytes
-    }
-
-    /// DeSerialize into a new FMU state; returns the status and the state (NULL on error).
-    pub fn deserialize(&self, bytes: &[u8]) -> (Fmi2Status, Fmi2FmuState) {
-        let mut s: Fmi2FmuState = ptr::null_mut();
-        let status = unsafe {
-            crate::fmi2DeSerializeFMUstate(self.c, bytes.as_ptr().cast(), bytes.len(), &mut s)
-        };
-        (status, s)
-    }
+/// A new instance with logging off.
+pub fn new_fmu(name: &str) -> Fmu {
+    try_fmu(name, None, false).unwrap()
 }
 
-impl Drop for Fmu {
-    fn drop(&mut self) {
-        unsafe { crate::fmi2FreeInstance(self.c) };
-    }
+/// A new instance with logging on.
+pub fn logging_fmu(name: &str) -> Fmu {
+    try_fmu(name, None, true).unwrap()
 }

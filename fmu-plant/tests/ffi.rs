@@ -1,0 +1,448 @@
+//! TowingPlant through its exported FMI functions, in-process, as a master calls them:
+//! abuse (NULL handles, wrong GUID, wrong call order, unknown references, NaN inputs, bad
+//! scenarios, bad parameters), a discarded step, determinism and FMU state.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use fmi2_slave::ffi::Fmi2Status;
+use fmi2_slave::testing::{Exports, Fmu};
+use std::path::{Path, PathBuf};
+use towing_plant::variables::{self as vars, DESCRIPTION};
+
+fn exports() -> Exports {
+    fmi2_slave::exports_of!(towing_plant)
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
+}
+
+/// The repository's `scenarios/` folder as a resource URI: it holds `paper.toml`, like the
+/// packaged FMU's `resources/`.
+fn resources_uri() -> String {
+    format!("file://{}", root().join("scenarios").display()).replace(' ', "%20")
+}
+
+fn plant(name: &str) -> Fmu {
+    Fmu::try_new(exports(), &DESCRIPTION, name, Some(&resources_uri()), false)
+        .unwrap_or_else(|log| panic!("instantiate failed: {log:?}"))
+}
+
+const PULL: [(u32, f64); 2] = [(vars::tug_force(1, 0), 3.0), (vars::tension_cmd(1), 2.0)];
+
+fn pull(fmu: &Fmu) {
+    for (vr, v) in PULL {
+        assert_eq!(fmu.set_real(vr, v), Fmi2Status::Ok);
+    }
+}
+
+/// Every Real output's value reference.
+fn real_outputs() -> Vec<u32> {
+    DESCRIPTION
+        .variables
+        .iter()
+        .filter(|v| {
+            v.causality == fmi2_slave::Causality::Output
+                && v.value_type() == fmi2_slave::ValueType::Real
+        })
+        .map(|v| v.value_reference)
+        .collect()
+}
+
+fn run(fmu: &Fmu, t0: f64, steps: usize) -> (Vec<Vec<f64>>, f64) {
+    let outputs = real_outputs();
+    let mut rows = Vec::with_capacity(steps);
+    let mut t = t0;
+    for _ in 0..steps {
+        assert_eq!(fmu.step(t, 0.1), Fmi2Status::Ok, "{}", fmu.log_text());
+        t += 0.1;
+        let (s, v) = fmu.try_get_reals(&outputs);
+        assert_eq!(s, Fmi2Status::Ok);
+        rows.push(v);
+    }
+    (rows, t)
+}
+
+fn bits(rows: &[Vec<f64>]) -> Vec<Vec<u64>> {
+    rows.iter()
+        .map(|r| r.iter().map(|x| x.to_bits()).collect())
+        .collect()
+}
+
+#[test]
+fn default_scenario_comes_from_the_resources_folder() {
+    let fmu = plant("default");
+    fmu.init(0.0, None);
+    assert_eq!(fmu.get_real(vars::vessel_state(0, 0)), -4.9);
+    assert_eq!(fmu.get_real(vars::vessel_state(0, 1)), 7.0);
+    assert_eq!(
+        fmu.get_integer(vars::obstacle_output(0, vars::OBSTACLE_KIND)),
+        1
+    );
+    assert_eq!(
+        fmu.get_integer(vars::obstacle_output(6, vars::OBSTACLE_KIND)),
+        0
+    );
+}
+
+#[test]
+fn without_resources_and_scenario_initialization_is_refused_with_a_reason() {
+    let fmu = Fmu::try_new(exports(), &DESCRIPTION, "bare", None, false).unwrap();
+    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
+    assert_eq!(fmu.enter_init(), Fmi2Status::Error);
+    assert!(
+        fmu.last_text().contains("set scenario"),
+        "{}",
+        fmu.log_text()
+    );
+}
+
+#[test]
+fn wrong_guid_gives_null_and_says_why() {
+    let log = Fmu::try_new_with_guid(exports(), "{not-the-guid}", "g", None, false).unwrap_err();
+    let text: String = log.iter().map(|m| m.text.clone()).collect();
+    assert!(
+        text.contains("{not-the-guid}") && text.contains(&DESCRIPTION.guid()),
+        "{text}"
+    );
+}
+
+#[test]
+fn null_component_is_an_error_not_a_crash() {
+    let e = exports();
+    let vr = vars::vessel_state(0, 0);
+    let mut x = 0.0;
+    // SAFETY: NULL is what is being tested; the layer must check it before any dereference.
+    #[allow(unsafe_code)]
+    unsafe {
+        assert_eq!(
+            (e.do_step)(std::ptr::null_mut(), 0.0, 0.1, 1),
+            Fmi2Status::Error
+        );
+        assert_eq!(
+            (e.get_real)(std::ptr::null_mut(), &vr, 1, &mut x),
+            Fmi2Status::Error
+        );
+        assert_eq!(
+            (e.enter_initialization_mode)(std::ptr::null_mut()),
+            Fmi2Status::Error
+        );
+        (e.free_instance)(std::ptr::null_mut());
+    }
+}
+
+#[test]
+fn wrong_call_order_is_an_error() {
+    let fmu = plant("order");
+    assert_eq!(fmu.step(0.0, 0.1), Fmi2Status::Error);
+    assert!(
+        fmu.last_text().contains("Illegal call sequence"),
+        "{}",
+        fmu.log_text()
+    );
+}
+
+#[test]
+fn unknown_value_reference_is_an_error_naming_it() {
+    let fmu = plant("unknown");
+    fmu.init(0.0, None);
+    assert_eq!(fmu.set_real(4242, 1.0).clone(), Fmi2Status::Error);
+    assert!(fmu.last_text().contains("4242"), "{}", fmu.log_text());
+}
+
+#[test]
+fn non_finite_inputs_are_refused_naming_the_variable_and_keeping_the_value() {
+    for (i, bad) in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY]
+        .into_iter()
+        .enumerate()
+    {
+        let fmu = plant(&format!("nan{i}"));
+        fmu.init(0.0, None);
+        let vr = vars::tug_force(0, 2);
+        assert_eq!(fmu.set_real(vr, 1.5), Fmi2Status::Ok);
+        assert_eq!(fmu.set_real(vr, bad), Fmi2Status::Error);
+        assert!(
+            fmu.last_text().contains("tug1.moment_yaw"),
+            "{}",
+            fmu.log_text()
+        );
+        assert_eq!(fmu.get_real(vr), 1.5, "previous value kept");
+    }
+}
+
+#[test]
+fn bad_parameters_are_refused_naming_the_parameter() {
+    let fmu = plant("params");
+    assert_eq!(fmu.set_integer(vars::HULL_MODEL, 7), Fmi2Status::Error);
+    assert!(fmu.last_text().contains("hull_model") && fmu.last_text().contains('7'));
+    let fmu = plant("params2");
+    assert_eq!(fmu.set_real(vars::INTEGRATION_STEP, 0.5), Fmi2Status::Error);
+    assert!(
+        fmu.last_text().contains("integration_step"),
+        "{}",
+        fmu.log_text()
+    );
+    let fmu = plant("params3");
+    assert_eq!(fmu.set_integer(vars::TOWLINE_MODEL, -1), Fmi2Status::Error);
+    assert!(
+        fmu.last_text().contains("towline_model"),
+        "{}",
+        fmu.log_text()
+    );
+}
+
+/// The paper scenario with one replacement applied (the original text must be present).
+fn edited_paper(from: &str, to: &str) -> String {
+    let text = std::fs::read_to_string(root().join("scenarios/paper.toml")).unwrap();
+    assert!(text.contains(from), "paper.toml lacks {from:?}");
+    text.replacen(from, to, 1)
+}
+
+/// Writes `text` to a scenario file, points a fresh plant at it, enters initialization and
+/// returns the status and the error text.
+fn initialize_with(text: &str) -> (Fmi2Status, String, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("my scenario.toml");
+    std::fs::write(&path, text).unwrap();
+    let fmu = plant("scenario");
+    assert_eq!(
+        fmu.set_string(vars::SCENARIO, path.to_str().unwrap()),
+        Fmi2Status::Ok
+    );
+    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
+    let status = fmu.enter_init();
+    let text = fmu
+        .messages()
+        .iter()
+        .filter(|m| m.status >= Fmi2Status::Error as i32)
+        .map(|m| m.text.clone())
+        .collect::<Vec<_>>()
+        .join("\n");
+    (status, text, path)
+}
+
+#[test]
+fn every_kind_of_bad_scenario_is_refused_naming_file_field_and_reason() {
+    let seven_more = (0..3)
+        .map(|i| {
+            format!(
+                "\n[[obstacles]]\nname = \"extra{i}\"\nkind = \"static\"\nx = {}\ny = 0.0\ndiameter = 1.0\n",
+                100 + i
+            )
+        })
+        .collect::<String>();
+    let cases: Vec<(&str, String, &str, &str)> = vec![
+        (
+            "syntax error",
+            "name = \"paper\n[ship\n".to_owned(),
+            "",
+            "syntax",
+        ),
+        (
+            "unknown field",
+            edited_paper("psi_deg = 101.3\n", "psi_deg = 101.3\nheading = 3\n"),
+            "ship.heading",
+            "unknown field",
+        ),
+        (
+            "missing field",
+            edited_paper("[towline2]\ndesired_length = 1.0\n", "[towline2]\n"),
+            "towline2.desired_length",
+            "missing",
+        ),
+        (
+            "wrong type",
+            edited_paper("x = -4.9\n", "x = \"north\"\n"),
+            "ship.x",
+            "invalid type",
+        ),
+        (
+            "negative length",
+            edited_paper("length = 1.48", "length = -1.48"),
+            "obstacles[3].length",
+            "> 0",
+        ),
+        (
+            "NaN value",
+            edited_paper(
+                "speed = 0.07\nactivation_time = 405.0",
+                "speed = nan\nactivation_time = 405.0",
+            ),
+            "obstacles[4].speed",
+            "finite",
+        ),
+        (
+            "infinite value",
+            edited_paper("desired_length = 1.0", "desired_length = inf"),
+            "towline1.desired_length",
+            "finite",
+        ),
+        (
+            "negative speed",
+            edited_paper(
+                "speed = 0.07\nactivation_time = 590.0",
+                "speed = -0.07\nactivation_time = 590.0",
+            ),
+            "obstacles[5].speed",
+            ">= 0",
+        ),
+        (
+            "too many obstacles",
+            edited_paper(
+                "\n# Physics of the plant",
+                &format!("{seven_more}\n# Physics of the plant"),
+            ),
+            "obstacles",
+            "8",
+        ),
+    ];
+    for (what, text, field, reason) in cases {
+        let (status, message, path) = initialize_with(&text);
+        assert_eq!(status, Fmi2Status::Error, "{what}: not refused");
+        assert!(
+            message.contains(path.to_str().unwrap()),
+            "{what}: message does not name the file: {message}"
+        );
+        assert!(
+            message.contains(field),
+            "{what}: message does not name {field:?}: {message}"
+        );
+        assert!(
+            message.to_lowercase().contains(&reason.to_lowercase()),
+            "{what}: message does not give the reason {reason:?}: {message}"
+        );
+    }
+}
+
+#[test]
+fn a_missing_scenario_file_is_refused_naming_it() {
+    let fmu = plant("missing");
+    assert_eq!(
+        fmu.set_string(vars::SCENARIO, "/nonexistent/dir/s.toml"),
+        Fmi2Status::Ok
+    );
+    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
+    assert_eq!(fmu.enter_init(), Fmi2Status::Error);
+    assert!(
+        fmu.last_text().contains("/nonexistent/dir/s.toml"),
+        "{}",
+        fmu.log_text()
+    );
+}
+
+#[test]
+fn a_step_that_would_go_non_finite_is_discarded_at_the_last_good_time() {
+    let stiff = edited_paper(
+        "towline_model = \"ideal_winch\"\nintegration_step = 0.01\n",
+        "towline_model = \"elastic\"\nintegration_step = 0.1\n[simulation.elastic_towline]\nstiffness = 1e9\n",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("stiff.toml");
+    std::fs::write(&path, stiff).unwrap();
+    let fmu = plant("stiff");
+    assert_eq!(
+        fmu.set_string(vars::SCENARIO, path.to_str().unwrap()),
+        Fmi2Status::Ok
+    );
+    fmu.init(0.0, None);
+    pull(&fmu);
+    let mut t = 0.0;
+    let mut status = Fmi2Status::Ok;
+    for _ in 0..1000 {
+        status = fmu.step(t, 0.1);
+        if status != Fmi2Status::Ok {
+            break;
+        }
+        t += 0.1;
+    }
+    assert_eq!(status, Fmi2Status::Discard, "{}", fmu.log_text());
+    assert!((fmu.last_successful_time() - t).abs() < 1e-9);
+    let (s, values) = fmu.try_get_reals(&real_outputs());
+    assert_eq!(s, Fmi2Status::Ok);
+    assert!(values.iter().all(|v| v.is_finite()), "outputs stay finite");
+    assert_eq!(fmu.terminate(), Fmi2Status::Ok);
+}
+
+#[test]
+fn two_runs_are_bit_identical() {
+    let a = plant("a");
+    let b = plant("b");
+    for fmu in [&a, &b] {
+        fmu.init(0.0, None);
+        pull(fmu);
+    }
+    let (ra, _) = run(&a, 0.0, 300);
+    let (rb, _) = run(&b, 0.0, 300);
+    assert_eq!(bits(&ra), bits(&rb));
+}
+
+#[test]
+fn fmu_state_and_serialization_reproduce_a_trajectory_exactly() {
+    let fmu = plant("state");
+    fmu.init(0.0, None);
+    pull(&fmu);
+    let (_, t) = run(&fmu, 0.0, 100);
+    let saved = fmu.get_state();
+    let bytes = fmu.serialize();
+    let (first, _) = run(&fmu, t, 200);
+
+    // SAFETY: `saved` is a live state of this instance, freed once below.
+    assert_eq!(unsafe { fmu.set_state(saved) }, Fmi2Status::Ok);
+    let (again, _) = run(&fmu, t, 200);
+    assert_eq!(bits(&first), bits(&again));
+    unsafe { fmu.free_state(saved) };
+
+    // A fresh instance that never saw the scenario restores everything from the bytes.
+    let fresh = Fmu::try_new(exports(), &DESCRIPTION, "fresh", None, false).unwrap();
+    assert_eq!(fresh.setup(0.0, None), Fmi2Status::Ok);
+    let (status, state) = fresh.deserialize(&bytes);
+    assert_eq!(status, Fmi2Status::Ok, "{}", fresh.log_text());
+    // SAFETY: `state` was just deserialized by this instance and is freed once.
+    assert_eq!(
+        unsafe { fresh.set_state(state) },
+        Fmi2Status::Ok,
+        "{}",
+        fresh.log_text()
+    );
+    unsafe { fresh.free_state(state) };
+    let (third, _) = run(&fresh, t, 200);
+    assert_eq!(bits(&first), bits(&third));
+}
+
+#[test]
+fn corrupted_serialized_state_is_refused() {
+    let fmu = plant("corrupt");
+    fmu.init(0.0, None);
+    let mut bytes = fmu.serialize();
+    let n = bytes.len();
+    bytes.truncate(n - 10);
+    let (status, state) = fmu.deserialize(&bytes);
+    assert_eq!(status, Fmi2Status::Error);
+    assert!(state.is_null());
+}
+
+#[test]
+fn hull_model_parameter_overrides_the_scenario() {
+    let linear = plant("linear");
+    assert_eq!(linear.set_integer(vars::HULL_MODEL, 1), Fmi2Status::Ok);
+    let nonlinear = plant("nonlinear");
+    for fmu in [&linear, &nonlinear] {
+        fmu.init(0.0, None);
+        pull(fmu);
+    }
+    let (a, _) = run(&linear, 0.0, 200);
+    let (b, _) = run(&nonlinear, 0.0, 200);
+    let u = real_outputs()
+        .iter()
+        .position(|&vr| vr == vars::vessel_state(0, 3))
+        .unwrap();
+    // Nonlinear damping adds drag: the towed ship is slower than with linear damping alone.
+    assert!(
+        a[199][u] > b[199][u] + 1e-3,
+        "linear {} vs nonlinear {}",
+        a[199][u],
+        b[199][u]
+    );
+}
