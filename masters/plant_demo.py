@@ -1,9 +1,12 @@
 """Runs the TowingPlant FMU alone under fmpy with constant inputs and draws the tow's track.
 
-The forward tug (tug2) pulls ahead with 3 N of surge thrust holding 2 N on its towline; the
-aft tug (tug1) follows with 1 N of thrust and holds 0.5 N on its line. Nothing steers, so the
-tow runs off along its initial heading in the paper scenario: this shows the plant, its
-towline coupling and the traffic, not the controller (that is the closed-loop demo).
+The forward tug (tug2) tows with 1 N on its towline (ideal winch) and 2.12 N of surge thrust:
+at 1 N of tension CyberShip II settles at 0.426 m/s (Skjetne et al. 2004), where the tug's
+own drag (d11 = 2.64 N s/m, damping set A) takes the other 1.12 N, so the tow settles into a
+steady run. The aft tug (tug1) is idle with its line slack: a slack line transmits no force,
+so it stays behind. Nothing steers. The TitoNeri's sway-yaw motion is open-loop unstable at
+this speed (../shared/reference/vessels.md), so the unsteered forward tug eventually yaws
+off the line: the reason the controller needs a tug loop that stabilises it.
 
 Writes OUT/track.csv (every output, one row per 0.1 s) and OUT/track.png (map: East
 horizontal, North vertical, equal aspect).
@@ -21,10 +24,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 from fmpy.util import write_csv  # noqa: E402
 
 INPUTS = {
-    "tug2.force_surge": 3.0,
-    "towline2.tension_cmd": 2.0,
-    "tug1.force_surge": 1.0,
-    "towline1.tension_cmd": 0.5,
+    "tug2.force_surge": 2.12,
+    "towline2.tension_cmd": 1.0,
+    "tug1.force_surge": 0.0,
+    "towline1.tension_cmd": 0.0,
 }
 
 VESSELS = {"ship": (1.255, 0.29, "tab:red"), "tug1": (0.97, 0.30, "tab:green"), "tug2": (0.97, 0.30, "tab:blue")}
@@ -43,7 +46,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--fmu", required=True, help="path of TowingPlant.fmu")
     parser.add_argument("--out", required=True, help="output directory")
-    parser.add_argument("--stop-time", type=float, default=120.0, help="simulated seconds (default 120)")
+    parser.add_argument("--stop-time", type=float, default=100.0, help="simulated seconds (default 100)")
     args = parser.parse_args()
 
     out = pathlib.Path(args.out)
@@ -78,10 +81,10 @@ def main():
     ax.set_aspect("equal")
     ax.set_xlabel("East y (m)")
     ax.set_ylabel("North x (m)")
-    ax.set_title(f"TowingPlant under fmpy, constant thrust, {args.stop_time:g} s")
+    ax.set_title(f"TowingPlant under fmpy: forward tug towing, aft tug idle, {args.stop_time:g} s")
     ax.grid(True, lw=0.3)
     ax.legend()
-    fig.savefig(out / "track.png", dpi=120)
+    fig.savefig(out / "track.png", dpi=120, bbox_inches="tight")
     print(f"wrote {out / 'track.csv'} and {out / 'track.png'}")
 
 
