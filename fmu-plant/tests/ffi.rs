@@ -486,9 +486,15 @@ fn free_decay_after_a_turn_never_gains_energy_with_the_default_hull() {
         vars::tug_force(0, 1),
         vars::tension_cmd(0),
     ];
-    assert_eq!(fmu.set_reals(&inputs, &[4.0, 2.0, 2.5, 1.0, -1.0, 0.5]), Fmi2Status::Ok);
+    assert_eq!(
+        fmu.set_reals(&inputs, &[4.0, 2.0, 2.5, 1.0, -1.0, 0.5]),
+        Fmi2Status::Ok
+    );
     let (_, mut t) = run(&fmu, 0.0, 600);
-    assert!(fmu.get_real(vars::vessel_state(0, 5)).abs() > 1e-3, "the tow is turning");
+    assert!(
+        fmu.get_real(vars::vessel_state(0, 5)).abs() > 1e-3,
+        "the tow is turning"
+    );
     assert_eq!(fmu.set_reals(&inputs, &[0.0; 6]), Fmi2Status::Ok);
     let mut previous = kinetic_energy(&fmu);
     assert!(previous[0] > 1e-3, "the ship is moving");
@@ -497,11 +503,19 @@ fn free_decay_after_a_turn_never_gains_energy_with_the_default_hull() {
         t += 0.1;
         let e = kinetic_energy(&fmu);
         for i in 0..3 {
-            assert!(e[i] <= previous[i], "vessel {i} gained energy at t = {t}: {} -> {}", previous[i], e[i]);
+            assert!(
+                e[i] <= previous[i],
+                "vessel {i} gained energy at t = {t}: {} -> {}",
+                previous[i],
+                e[i]
+            );
         }
         previous = e;
     }
-    assert!(previous.iter().all(|&e| e < 1e-5), "came to rest: {previous:?}");
+    assert!(
+        previous.iter().all(|&e| e < 1e-5),
+        "came to rest: {previous:?}"
+    );
 }
 
 /// Eight instances stepped concurrently on eight threads (as libcosim's pool does) give the

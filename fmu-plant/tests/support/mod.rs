@@ -34,11 +34,17 @@ impl Bench {
             false,
         )
         .unwrap();
-        assert_eq!(fmu.set_string(vars::SCENARIO, scenario.to_str().unwrap()), Fmi2Status::Ok);
+        assert_eq!(
+            fmu.set_string(vars::SCENARIO, scenario.to_str().unwrap()),
+            Fmi2Status::Ok
+        );
         assert_eq!(fmu.set_integer(vars::HULL_MODEL, 2), Fmi2Status::Ok);
         fmu.init(0.0, None);
         for slot in 0..8 {
-            assert_ne!(fmu.get_integer(vars::obstacle_output(slot, vars::OBSTACLE_KIND)), 0);
+            assert_ne!(
+                fmu.get_integer(vars::obstacle_output(slot, vars::OBSTACLE_KIND)),
+                0
+            );
         }
         let output_vrs: Vec<u32> = DESCRIPTION
             .variables
