@@ -26,8 +26,7 @@ fn main() {
     times.sort_by(f64::total_cmp);
     let at = |q: f64| times[((n as f64 - 1.0) * q).round() as usize];
     println!(
-        "TowingPlant communication step (set 8 inputs, DoStep 0.1 s, get {} outputs), {n} samples: median {:.2} us, p99 {:.2} us, max {:.2} us",
-        "all Real",
+        "TowingPlant communication step (set 8 inputs, DoStep 0.1 s, get all Real outputs), {n} samples: median {:.2} us, p99 {:.2} us, max {:.2} us",
         at(0.5),
         at(0.99),
         times[n - 1]

@@ -16,7 +16,7 @@
 
 use fmi2_slave::description::{
     BaseUnit, Causality, DefaultExperiment, DisplayUnit, Initial, LogCategory, ModelDescription,
-    UnitDefinition, Variability, Variable, VariableKind,
+    SimpleType, UnitDefinition, Variability, Variable, VariableKind,
 };
 use std::sync::LazyLock;
 use towing_model::{WorldConfig, MAX_OBSTACLES};
@@ -120,6 +120,53 @@ pub const OBSTACLE_FIELDS: [(&str, &str, &str); 6] = [
 /// The model identifier (binary name).
 pub const MODEL_IDENTIFIER: &str = "TowingPlant";
 
+/// Name of the Integer type of the `obstacle[k].kind` outputs.
+pub const OBSTACLE_KIND_TYPE: &str = "ObstacleKind";
+
+/// The Real types (`TypeDefinitions`): name, quantity (the conventional Modelica name),
+/// unit, display unit. Every Real variable declares the type of its unit
+/// ([`declared_type_of_unit`]).
+const REAL_TYPES: [(&str, &str, &str, Option<&str>); 7] = [
+    ("Length", "Length", "m", None),
+    ("Angle", "Angle", "rad", Some("deg")),
+    ("Velocity", "Velocity", "m/s", None),
+    ("AngularVelocity", "AngularVelocity", "rad/s", Some("deg/s")),
+    ("Force", "Force", "N", None),
+    ("Torque", "Torque", "N.m", None),
+    ("Time", "Time", "s", None),
+];
+
+/// The declared type of a Real variable with unit `unit`.
+///
+/// # Panics
+/// If no type of [`REAL_TYPES`] has that unit (a programming error in the variable table).
+fn declared_type_of_unit(unit: &str) -> &'static str {
+    REAL_TYPES
+        .iter()
+        .find(|(_, _, u, _)| *u == unit)
+        .map(|(name, ..)| *name)
+        .unwrap_or_else(|| panic!("no SimpleType for unit '{unit}'"))
+}
+
+fn type_definitions() -> Vec<SimpleType> {
+    let mut types: Vec<SimpleType> = REAL_TYPES
+        .iter()
+        .map(|&(name, quantity, unit, display)| {
+            let t = SimpleType::real(name, quantity, unit);
+            match display {
+                Some(d) => t.with_display_unit(d),
+                None => t,
+            }
+        })
+        .collect();
+    types.push(
+        SimpleType::integer(OBSTACLE_KIND_TYPE, "ObstacleKind")
+            .with_integer_range(0, 2)
+            .with_description("0 none, 1 static circle, 2 vessel ellipse"),
+    );
+    types
+}
+
 /// The plant's model description, built once.
 pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(build);
 
@@ -148,6 +195,7 @@ fn real(name: String, vr: u32, causality: Causality, unit: &str, description: St
         variability,
         initial,
         kind: VariableKind::Real {
+            declared_type: Some(declared_type_of_unit(unit).to_owned()),
             unit: Some(unit.to_owned()),
             display_unit,
             start,
@@ -202,6 +250,7 @@ fn build() -> ModelDescription {
             "hull_model",
             HULL_MODEL,
             VariableKind::Integer {
+                declared_type: None,
                 start: Some(0),
                 min: Some(0),
                 max: Some(2),
@@ -212,6 +261,7 @@ fn build() -> ModelDescription {
             "towline_model",
             TOWLINE_MODEL,
             VariableKind::Integer {
+                declared_type: None,
                 start: Some(0),
                 min: Some(0),
                 max: Some(2),
@@ -222,6 +272,7 @@ fn build() -> ModelDescription {
             "integration_step",
             INTEGRATION_STEP,
             VariableKind::Real {
+                declared_type: Some(declared_type_of_unit("s").to_owned()),
                 unit: Some("s".to_owned()),
                 display_unit: None,
                 start: Some(0.0),
@@ -335,6 +386,7 @@ fn build() -> ModelDescription {
             variability: Variability::Discrete,
             initial: Some(Initial::Calculated),
             kind: VariableKind::Integer {
+                declared_type: Some(OBSTACLE_KIND_TYPE.to_owned()),
                 start: None,
                 min: Some(0),
                 max: Some(2),
@@ -367,6 +419,7 @@ fn build() -> ModelDescription {
             unit("N.m", BaseUnit { kg: 1, m: 2, s: -2, factor: 1.0, ..BaseUnit::default() }, None),
             unit("s", BaseUnit { s: 1, factor: 1.0, ..BaseUnit::default() }, None),
         ],
+        type_definitions: type_definitions(),
         log_categories: {
             let mut c = LogCategory::standard();
             c.push(LogCategory::new(

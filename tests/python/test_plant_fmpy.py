@@ -186,3 +186,51 @@ def test_discarded_step_keeps_last_successful_time(plant_fmu, tmp_path, paper_sc
     assert "non-finite" in log.text("DISCARD").lower() or "not finite" in log.text("DISCARD").lower(), log.text()
     s.terminate()
     s.freeInstance()
+
+
+RESTORE_IN_ANOTHER_PROCESS = r"""
+import json, sys
+import fmpy
+from fmpy.fmi2 import FMU2Slave
+fmu, state_file, unzipdir, t = sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4])
+md = fmpy.read_model_description(fmu)
+vrs = {v.name: v.valueReference for v in md.modelVariables}
+s = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier="TowingPlant", instanceName="other")
+s.instantiate()
+s.setupExperiment(startTime=0.0)
+state = s.deSerializeFMUstate(open(state_file, "rb").read())
+s.setFMUstate(state)
+rows = []
+for _ in range(50):
+    s.doStep(t, 0.1)
+    t += 0.1
+    rows.append(s.getReal([vrs[k] for k in ("ship.x", "ship.y", "ship.psi", "tug2.u", "towline2.length")]))
+print(json.dumps([[v.hex() for v in r] for r in rows]))
+"""
+
+
+def test_serialized_state_restores_in_another_process(plant_fmu, tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    log = MessageLog()
+    s, vrs = slave(plant_fmu, tmp_path, log)
+    start(s, vrs)
+    _, t = run_steps(s, vrs, 0.0, 50)
+    state = s.getFMUstate()
+    (tmp_path / "state.bin").write_bytes(s.serializeFMUstate(state))
+    expected, _ = run_steps(s, vrs, t, 50)
+    other_dir = tmp_path / "other"
+    fmpy.extract(plant_fmu, str(other_dir))
+    out = subprocess.run(
+        [sys.executable, "-c", RESTORE_IN_ANOTHER_PROCESS, plant_fmu, str(tmp_path / "state.bin"), str(other_dir), repr(t)],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
+    got = json.loads(out.stdout.strip().splitlines()[-1])
+    assert got == [[v.hex() for v in r] for r in expected]
+    s.freeFMUstate(state)
+    s.terminate()
+    s.freeInstance()

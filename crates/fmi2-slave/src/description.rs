@@ -10,9 +10,12 @@
 //! tests), following FMI 2.0 sections 2.2.1 to 2.2.8 and what fmpy's and fmi-rs's validators
 //! enforce:
 //!
-//! * element order `CoSimulation`, `UnitDefinitions`, `LogCategories`, `DefaultExperiment`,
-//!   `ModelVariables`, `ModelStructure` (empty `UnitDefinitions`/`LogCategories` omitted,
-//!   no `TypeDefinitions`, no `VendorAnnotations`);
+//! * element order `CoSimulation`, `UnitDefinitions`, `TypeDefinitions`, `LogCategories`,
+//!   `DefaultExperiment`, `ModelVariables`, `ModelStructure` (empty
+//!   `UnitDefinitions`/`TypeDefinitions`/`LogCategories` omitted, no `VendorAnnotations`);
+//! * a variable's `declaredType` names a `SimpleType` of the same base type whose units are
+//!   declared; the variable still writes its own `unit`/`displayUnit` (which must agree
+//!   with the type's);
 //! * `causality` and `variability` always written; `initial` written explicitly (the
 //!   effective value) for every variable except inputs and the independent variable, which
 //!   must not carry it;
@@ -42,6 +45,9 @@ pub struct ModelDescription {
     pub generation_tool: String,
     /// `UnitDefinitions` (FMI 2.0 section 2.2.2). Every unit a variable uses must be here.
     pub units: Vec<UnitDefinition>,
+    /// `TypeDefinitions` (FMI 2.0 section 2.2.3): named types that variables refer to with
+    /// `declaredType`. Written after `UnitDefinitions`, omitted when empty.
+    pub type_definitions: Vec<SimpleType>,
     /// `LogCategories` (FMI 2.0 section 2.2.4); the names `fmi2SetDebugLogging` accepts.
     pub log_categories: Vec<LogCategory>,
     /// `DefaultExperiment` (FMI 2.0 section 2.2.5); fmpy uses `step_size` as its step.
@@ -137,6 +143,150 @@ pub struct DisplayUnit {
     pub factor: f64,
     /// Offset.
     pub offset: f64,
+}
+
+/// `TypeDefinitions/SimpleType` (FMI 2.0 section 2.2.3): a named set of default
+/// attributes (quantity, unit, range) that a variable refers to with `declaredType`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimpleType {
+    /// `name`, unique among the types; what `declaredType` refers to.
+    pub name: String,
+    /// `description` (omitted when empty).
+    pub description: String,
+    /// The base type and its attributes (the child element).
+    pub kind: SimpleTypeKind,
+}
+
+/// The child element of a [`SimpleType`]. Only Real and Integer types are supported.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SimpleTypeKind {
+    /// `<Real>`.
+    Real {
+        /// `quantity`: physical quantity (free text, e.g. `"Angle"`).
+        quantity: Option<String>,
+        /// `unit`; must name a [`UnitDefinition`].
+        unit: Option<String>,
+        /// `displayUnit`; must name a [`DisplayUnit`] of `unit`.
+        display_unit: Option<String>,
+        /// Lower bound.
+        min: Option<f64>,
+        /// Upper bound.
+        max: Option<f64>,
+    },
+    /// `<Integer>`.
+    Integer {
+        /// `quantity` (free text).
+        quantity: Option<String>,
+        /// Lower bound.
+        min: Option<i32>,
+        /// Upper bound.
+        max: Option<i32>,
+    },
+}
+
+impl SimpleTypeKind {
+    /// The base type.
+    pub fn value_type(&self) -> ValueType {
+        match self {
+            SimpleTypeKind::Real { .. } => ValueType::Real,
+            SimpleTypeKind::Integer { .. } => ValueType::Integer,
+        }
+    }
+}
+
+impl SimpleType {
+    /// A Real type; `quantity` and `unit` take `""` for "none".
+    pub fn real(name: &str, quantity: &str, unit: &str) -> Self {
+        SimpleType {
+            name: name.to_string(),
+            description: String::new(),
+            kind: SimpleTypeKind::Real {
+                quantity: opt_unit(quantity),
+                unit: opt_unit(unit),
+                display_unit: None,
+                min: None,
+                max: None,
+            },
+        }
+    }
+
+    /// An Integer type; `quantity` takes `""` for "none".
+    pub fn integer(name: &str, quantity: &str) -> Self {
+        SimpleType {
+            name: name.to_string(),
+            description: String::new(),
+            kind: SimpleTypeKind::Integer {
+                quantity: opt_unit(quantity),
+                min: None,
+                max: None,
+            },
+        }
+    }
+
+    /// Sets `description`.
+    pub fn with_description(mut self, description: &str) -> Self {
+        self.description = description.to_string();
+        self
+    }
+
+    /// Sets the Real `displayUnit`.
+    ///
+    /// # Panics
+    /// If the type is not Real (a programming error in the type table).
+    pub fn with_display_unit(mut self, display_unit: &str) -> Self {
+        match &mut self.kind {
+            SimpleTypeKind::Real {
+                display_unit: d, ..
+            } => *d = Some(display_unit.to_string()),
+            SimpleTypeKind::Integer { .. } => {
+                panic!("with_display_unit on non-Real type '{}'", self.name)
+            }
+        }
+        self
+    }
+
+    /// Sets the Real `min` and `max`.
+    ///
+    /// # Panics
+    /// If the type is not Real (a programming error in the type table).
+    pub fn with_real_range(mut self, min: f64, max: f64) -> Self {
+        match &mut self.kind {
+            SimpleTypeKind::Real {
+                min: lo, max: hi, ..
+            } => {
+                *lo = Some(min);
+                *hi = Some(max);
+            }
+            SimpleTypeKind::Integer { .. } => {
+                panic!("with_real_range on non-Real type '{}'", self.name)
+            }
+        }
+        self
+    }
+
+    /// Sets the Integer `min` and `max`.
+    ///
+    /// # Panics
+    /// If the type is not Integer (a programming error in the type table).
+    pub fn with_integer_range(mut self, min: i32, max: i32) -> Self {
+        match &mut self.kind {
+            SimpleTypeKind::Integer {
+                min: lo, max: hi, ..
+            } => {
+                *lo = Some(min);
+                *hi = Some(max);
+            }
+            SimpleTypeKind::Real { .. } => {
+                panic!("with_integer_range on non-Integer type '{}'", self.name)
+            }
+        }
+        self
+    }
+
+    /// The base type.
+    pub fn value_type(&self) -> ValueType {
+        self.kind.value_type()
+    }
 }
 
 /// `LogCategories/Category` (FMI 2.0 section 2.2.4).
@@ -296,7 +446,9 @@ impl ValueType {
 pub enum VariableKind {
     /// `<Real>`.
     Real {
-        /// Must name a [`UnitDefinition`].
+        /// `declaredType`: must name a Real [`SimpleType`].
+        declared_type: Option<String>,
+        /// Must name a [`UnitDefinition`]; must equal the declared type's unit if both are given.
         unit: Option<String>,
         /// Must name a [`DisplayUnit`] of `unit`.
         display_unit: Option<String>,
@@ -309,6 +461,8 @@ pub enum VariableKind {
     },
     /// `<Integer>`.
     Integer {
+        /// `declaredType`: must name an Integer [`SimpleType`].
+        declared_type: Option<String>,
         /// Start value.
         start: Option<i32>,
         /// Lower bound.
@@ -336,6 +490,15 @@ impl VariableKind {
             VariableKind::Integer { .. } => ValueType::Integer,
             VariableKind::Boolean { .. } => ValueType::Boolean,
             VariableKind::String { .. } => ValueType::String,
+        }
+    }
+
+    /// The `declaredType` (Real and Integer only).
+    pub fn declared_type(&self) -> Option<&str> {
+        match self {
+            VariableKind::Real { declared_type, .. }
+            | VariableKind::Integer { declared_type, .. } => declared_type.as_deref(),
+            VariableKind::Boolean { .. } | VariableKind::String { .. } => None,
         }
     }
 
@@ -369,6 +532,7 @@ impl VariableKind {
 /// `unit` arguments take `""` for "no unit". Refine with the builder methods
 /// ([`initial_depends_on`](Self::initial_depends_on),
 /// [`output_depends_on`](Self::output_depends_on), [`with_display_unit`](Self::with_display_unit),
+/// [`with_declared_type`](Self::with_declared_type),
 /// [`with_real_range`](Self::with_real_range), [`with_integer_range`](Self::with_integer_range),
 /// [`with_variability`](Self::with_variability)) or write the struct literally.
 #[derive(Debug, Clone, PartialEq)]
@@ -433,6 +597,7 @@ impl Variable {
 
     fn real_kind(unit: &str, start: Option<f64>) -> VariableKind {
         VariableKind::Real {
+            declared_type: None,
             unit: opt_unit(unit),
             display_unit: None,
             start,
@@ -520,6 +685,7 @@ impl Variable {
             Variability::Discrete,
             None,
             VariableKind::Integer {
+                declared_type: None,
                 start: Some(start),
                 min: None,
                 max: None,
@@ -543,6 +709,7 @@ impl Variable {
             variability,
             Some(Initial::Exact),
             VariableKind::Integer {
+                declared_type: None,
                 start: Some(start),
                 min: None,
                 max: None,
@@ -560,6 +727,7 @@ impl Variable {
             Variability::Discrete,
             Some(Initial::Calculated),
             VariableKind::Integer {
+                declared_type: None,
                 start: None,
                 min: None,
                 max: None,
@@ -658,6 +826,25 @@ impl Variable {
                 display_unit: d, ..
             } => *d = Some(display_unit.to_string()),
             _ => panic!("with_display_unit on non-Real variable '{}'", self.name),
+        }
+        self
+    }
+
+    /// Sets `declaredType` (the name of a [`SimpleType`] of the same base type).
+    ///
+    /// # Panics
+    /// If the variable is neither Real nor Integer (a programming error in the variable
+    /// table).
+    pub fn with_declared_type(mut self, name: &str) -> Self {
+        match &mut self.kind {
+            VariableKind::Real { declared_type, .. }
+            | VariableKind::Integer { declared_type, .. } => {
+                *declared_type = Some(name.to_string());
+            }
+            VariableKind::Boolean { .. } | VariableKind::String { .. } => panic!(
+                "with_declared_type on non-Real/Integer variable '{}'",
+                self.name
+            ),
         }
         self
     }
@@ -808,7 +995,9 @@ impl ModelDescription {
     /// legal `initial`, no `initial` on inputs, start present exactly when required
     /// (exact/approx/input) and absent when calculated or independent, finite numbers with
     /// `min <= start <= max`, declared unit and display unit, at most one independent
-    /// variable; dependencies only on outputs/initial unknowns, referring to exactly one
+    /// variable; type definitions (unique non-empty names, declared units and display units,
+    /// finite `min <= max`); a variable's `declaredType` names an existing type of the same
+    /// base type, and a unit given by both the variable and its type agrees; dependencies only on outputs/initial unknowns, referring to exactly one
     /// existing eligible variable (inputs for outputs; inputs and parameters for initial
     /// unknowns; the independent variable for both), without duplicates.
     ///
@@ -820,6 +1009,7 @@ impl ModelDescription {
         let mut errors = Vec::new();
         self.validate_header(&mut errors);
         self.validate_units(&mut errors);
+        self.validate_types(&mut errors);
         self.validate_variables(&mut errors);
         self.validate_dependencies(&mut errors);
         if errors.is_empty() {
@@ -929,6 +1119,119 @@ impl ModelDescription {
         }
     }
 
+    fn validate_types(&self, errors: &mut Vec<String>) {
+        let mut names = HashSet::new();
+        for t in &self.type_definitions {
+            let n = t.name.as_str();
+            if n.is_empty() {
+                errors.push(format!(
+                    "type definition with empty name ({} type)",
+                    t.value_type().as_str()
+                ));
+            } else if !names.insert(n) {
+                errors.push(format!("type '{n}' is declared twice"));
+            }
+            let who = format!("type '{n}'");
+            check_text(errors, &who, n);
+            check_text(errors, &format!("description of {who}"), &t.description);
+            match &t.kind {
+                SimpleTypeKind::Real {
+                    quantity,
+                    unit,
+                    display_unit,
+                    min,
+                    max,
+                } => {
+                    if let Some(q) = quantity {
+                        check_text(errors, &format!("quantity of {who}"), q);
+                    }
+                    for (what, x) in [("min", min), ("max", max)] {
+                        if let Some(x) = x {
+                            if !x.is_finite() {
+                                errors.push(format!("{who}: {what} {x} is not finite"));
+                            }
+                        }
+                    }
+                    check_range(errors, &who, None, *min, *max);
+                    if let Some(u) = unit {
+                        if self.unit_definition(u).is_none() {
+                            errors.push(format!(
+                                "{who}: unit '{u}' is not declared in UnitDefinitions"
+                            ));
+                        }
+                    }
+                    if let Some(du) = display_unit {
+                        self.check_display_unit(errors, &who, unit.as_deref(), du);
+                    }
+                }
+                SimpleTypeKind::Integer { quantity, min, max } => {
+                    if let Some(q) = quantity {
+                        check_text(errors, &format!("quantity of {who}"), q);
+                    }
+                    check_range(errors, &who, None, *min, *max);
+                }
+            }
+        }
+    }
+
+    fn unit_definition(&self, name: &str) -> Option<&UnitDefinition> {
+        self.units.iter().find(|d| d.name == name)
+    }
+
+    /// The type definition named `name`.
+    pub fn simple_type(&self, name: &str) -> Option<&SimpleType> {
+        self.type_definitions.iter().find(|t| t.name == name)
+    }
+
+    /// Checks that `display_unit` is a display unit of `unit` (an undeclared `unit` is
+    /// reported elsewhere); `who` names the variable or type.
+    fn check_display_unit(
+        &self,
+        errors: &mut Vec<String>,
+        who: &str,
+        unit: Option<&str>,
+        display_unit: &str,
+    ) {
+        match unit {
+            None => errors.push(format!(
+                "{who}: displayUnit '{display_unit}' given without a unit"
+            )),
+            Some(u) => {
+                if let Some(def) = self.unit_definition(u) {
+                    if !def.display_units.iter().any(|d| d.name == display_unit) {
+                        errors.push(format!(
+                            "{who}: displayUnit '{display_unit}' is not declared for unit '{u}'"
+                        ));
+                    }
+                }
+            }
+        }
+    }
+
+    /// The variable's declared type, if it names an existing type of the variable's base
+    /// type; otherwise reports the problem and returns `None`.
+    fn check_declared_type(&self, errors: &mut Vec<String>, v: &Variable) -> Option<&SimpleType> {
+        let name = v.kind.declared_type()?;
+        let n = v.name.as_str();
+        match self.simple_type(name) {
+            None => {
+                errors.push(format!(
+                    "variable '{n}': declaredType '{name}' is not defined in TypeDefinitions"
+                ));
+                None
+            }
+            Some(t) if t.value_type() != v.value_type() => {
+                errors.push(format!(
+                    "variable '{n}': declaredType '{name}' is a {} type but the variable is {}",
+                    t.value_type().as_str(),
+                    v.value_type().as_str()
+                ));
+                None
+            }
+            Some(t) => Some(t),
+        }
+    }
+
     fn validate_variables(&self, errors: &mut Vec<String>) {
         let mut names: HashSet<&str> = HashSet::new();
         let mut refs: HashMap<(ValueType, u32), &str> = HashMap::new();
@@ -1028,8 +1331,11 @@ impl ModelDescription {
 
     fn validate_kind(&self, v: &Variable, errors: &mut Vec<String>) {
         let n = v.name.as_str();
+        let who = format!("variable '{n}'");
+        let declared = self.check_declared_type(errors, v);
         match &v.kind {
             VariableKind::Real {
+                declared_type: _,
                 unit,
                 display_unit,
                 start,
@@ -1043,37 +1349,38 @@ impl ModelDescription {
                         }
                     }
                 }
-                check_range(errors, n, *start, *min, *max);
-                let unit_def = match unit {
-                    Some(u) => {
-                        let def = self.units.iter().find(|d| &d.name == u);
-                        if def.is_none() {
-                            errors.push(format!(
-                                "variable '{n}': unit '{u}' is not declared in UnitDefinitions"
-                            ));
-                        }
-                        def
-                    }
-                    None => None,
-                };
-                if let Some(du) = display_unit {
-                    match (unit, unit_def) {
-                        (None, _) => errors.push(format!(
-                            "variable '{n}': displayUnit '{du}' given without a unit"
-                        )),
-                        (Some(u), Some(def)) => {
-                            if !def.display_units.iter().any(|d| &d.name == du) {
-                                errors.push(format!(
-                                    "variable '{n}': displayUnit '{du}' is not declared for unit '{u}'"
-                                ));
-                            }
-                        }
-                        (Some(_), None) => {} // already reported
+                check_range(errors, &who, *start, *min, *max);
+                if let Some(u) = unit {
+                    if self.unit_definition(u).is_none() {
+                        errors.push(format!(
+                            "variable '{n}': unit '{u}' is not declared in UnitDefinitions"
+                        ));
                     }
                 }
+                let type_unit = match declared.map(|t| &t.kind) {
+                    Some(SimpleTypeKind::Real { unit: Some(tu), .. }) => Some(tu.as_str()),
+                    _ => None,
+                };
+                if let (Some(u), Some(tu), Some(t)) = (unit, type_unit, declared) {
+                    if u != tu {
+                        errors.push(format!(
+                            "variable '{n}': unit '{u}' differs from unit '{tu}' of its declaredType '{}'",
+                            t.name
+                        ));
+                    }
+                }
+                if let Some(du) = display_unit {
+                    // A variable without its own unit inherits the declared type's.
+                    self.check_display_unit(errors, &who, unit.as_deref().or(type_unit), du);
+                }
             }
-            VariableKind::Integer { start, min, max } => {
-                check_range(errors, n, *start, *min, *max);
+            VariableKind::Integer {
+                declared_type: _,
+                start,
+                min,
+                max,
+            } => {
+                check_range(errors, &who, *start, *min, *max);
             }
             VariableKind::Boolean { .. } => {}
             VariableKind::String { start } => {
@@ -1230,6 +1537,14 @@ impl ModelDescription {
             x.push_str("  </UnitDefinitions>\n");
         }
 
+        if !self.type_definitions.is_empty() {
+            x.push_str("  <TypeDefinitions>\n");
+            for t in &self.type_definitions {
+                write_simple_type(&mut x, t);
+            }
+            x.push_str("  </TypeDefinitions>\n");
+        }
+
         if !self.log_categories.is_empty() {
             x.push_str("  <LogCategories>\n");
             for cat in &self.log_categories {
@@ -1344,6 +1659,53 @@ impl ModelDescription {
     }
 }
 
+fn write_simple_type(x: &mut String, t: &SimpleType) {
+    x.push_str("    <SimpleType");
+    attr(x, "name", &t.name);
+    if !t.description.is_empty() {
+        attr(x, "description", &t.description);
+    }
+    x.push_str(">\n      <");
+    x.push_str(t.value_type().as_str());
+    match &t.kind {
+        SimpleTypeKind::Real {
+            quantity,
+            unit,
+            display_unit,
+            min,
+            max,
+        } => {
+            for (name, value) in [
+                ("quantity", quantity),
+                ("unit", unit),
+                ("displayUnit", display_unit),
+            ] {
+                if let Some(value) = value {
+                    attr(x, name, value);
+                }
+            }
+            if let Some(m) = min {
+                attr(x, "min", &fmt_f64(*m));
+            }
+            if let Some(m) = max {
+                attr(x, "max", &fmt_f64(*m));
+            }
+        }
+        SimpleTypeKind::Integer { quantity, min, max } => {
+            if let Some(q) = quantity {
+                attr(x, "quantity", q);
+            }
+            if let Some(m) = min {
+                attr(x, "min", &m.to_string());
+            }
+            if let Some(m) = max {
+                attr(x, "max", &m.to_string());
+            }
+        }
+    }
+    x.push_str("/>\n    </SimpleType>\n");
+}
+
 fn write_variable(x: &mut String, index: usize, v: &Variable) {
     x.push_str("    <!-- ");
     x.push_str(&index.to_string());
@@ -1360,8 +1722,12 @@ fn write_variable(x: &mut String, index: usize, v: &Variable) {
     }
     x.push_str(">\n      <");
     x.push_str(v.value_type().as_str());
+    if let Some(t) = v.kind.declared_type() {
+        attr(x, "declaredType", t);
+    }
     match &v.kind {
         VariableKind::Real {
+            declared_type: _,
             unit,
             display_unit,
             start,
@@ -1384,7 +1750,12 @@ fn write_variable(x: &mut String, index: usize, v: &Variable) {
                 attr(x, "start", &fmt_f64(*s));
             }
         }
-        VariableKind::Integer { start, min, max } => {
+        VariableKind::Integer {
+            declared_type: _,
+            start,
+            min,
+            max,
+        } => {
             if let Some(m) = min {
                 attr(x, "min", &m.to_string());
             }
@@ -1409,29 +1780,28 @@ fn write_variable(x: &mut String, index: usize, v: &Variable) {
     x.push_str("/>\n    </ScalarVariable>\n");
 }
 
+/// Checks `min <= max` and `min <= start <= max`; `who` names the variable or type.
 fn check_range<T: PartialOrd + std::fmt::Display + Copy>(
     errors: &mut Vec<String>,
-    name: &str,
+    who: &str,
     start: Option<T>,
     min: Option<T>,
     max: Option<T>,
 ) {
     if let (Some(lo), Some(hi)) = (min, max) {
         if lo > hi {
-            errors.push(format!(
-                "variable '{name}': min {lo} is greater than max {hi}"
-            ));
+            errors.push(format!("{who}: min {lo} is greater than max {hi}"));
         }
     }
     if let Some(s) = start {
         if let Some(lo) = min {
             if s < lo {
-                errors.push(format!("variable '{name}': start {s} is below min {lo}"));
+                errors.push(format!("{who}: start {s} is below min {lo}"));
             }
         }
         if let Some(hi) = max {
             if s > hi {
-                errors.push(format!("variable '{name}': start {s} is above max {hi}"));
+                errors.push(format!("{who}: start {s} is above max {hi}"));
             }
         }
     }

@@ -31,6 +31,16 @@ fn unit_text(v: &Variable) -> String {
     }
 }
 
+/// The base type, with the declared type in parentheses when there is one
+/// (`Real (Angle)`).
+fn type_text(v: &Variable) -> String {
+    let base = v.value_type().as_str();
+    match v.kind.declared_type() {
+        Some(t) => format!("{base} ({t})"),
+        None => base.to_string(),
+    }
+}
+
 fn html_escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
@@ -42,8 +52,9 @@ fn md_escape(s: &str) -> String {
     s.replace('|', "\\|").replace('\n', " ")
 }
 
-/// Markdown table of every variable: name, causality, variability, type, unit, start, value
-/// reference and description, in ModelVariables order.
+/// Markdown table of every variable: name, causality, variability, type (with the declared
+/// type in parentheses, e.g. `Real (Angle)`), unit, start, value reference and description,
+/// in ModelVariables order.
 pub fn variables_markdown(md: &ModelDescription) -> String {
     let mut out = String::from(
         "| name | causality | variability | type | unit | start | vr | description |\n\
@@ -55,7 +66,7 @@ pub fn variables_markdown(md: &ModelDescription) -> String {
             md_escape(&v.name),
             v.causality.as_str(),
             v.variability.as_str(),
-            v.kind.value_type().as_str(),
+            md_escape(&type_text(v)),
             md_escape(&unit_text(v)),
             md_escape(&start_text(v)),
             v.value_reference,
@@ -78,7 +89,7 @@ pub fn documentation_html(md: &ModelDescription) -> String {
             html_escape(&v.name),
             v.causality.as_str(),
             v.variability.as_str(),
-            v.kind.value_type().as_str(),
+            html_escape(&type_text(v)),
             html_escape(&unit_text(v)),
             html_escape(&start_text(v)),
             v.value_reference,
@@ -125,7 +136,10 @@ body frame x forward, y starboard. Angles in radians.</p>\n\
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::description::{Causality, DefaultExperiment, LogCategory, Variability};
+    use crate::description::{
+        BaseUnit, Causality, DefaultExperiment, LogCategory, SimpleType, UnitDefinition,
+        Variability,
+    };
 
     fn md() -> ModelDescription {
         ModelDescription {
@@ -135,7 +149,14 @@ mod tests {
             author: String::new(),
             version: "1".into(),
             generation_tool: "t".into(),
-            units: vec![],
+            units: vec![UnitDefinition::new(
+                "rad",
+                BaseUnit {
+                    rad: 1,
+                    ..BaseUnit::default()
+                },
+            )],
+            type_definitions: vec![SimpleType::real("Angle", "Angle", "rad")],
             log_categories: LogCategory::standard(),
             default_experiment: DefaultExperiment {
                 start_time: 0.0,
@@ -143,14 +164,10 @@ mod tests {
                 tolerance: None,
                 step_size: 0.1,
             },
-            variables: vec![Variable::real_parameter(
-                "a|b",
-                1,
-                "",
-                0.5,
-                Variability::Fixed,
-                "x < y",
-            )],
+            variables: vec![
+                Variable::real_parameter("a|b", 1, "", 0.5, Variability::Fixed, "x < y"),
+                Variable::real_input("psi", 2, "rad", 0.0, "heading").with_declared_type("Angle"),
+            ],
         }
     }
 
@@ -159,6 +176,9 @@ mod tests {
         let m = md();
         let text = variables_markdown(&m);
         assert!(text.contains("| `a\\|b` | parameter | fixed | Real |  | 0.5 | 1 | x < y |"));
+        assert!(
+            text.contains("| `psi` | input | continuous | Real (Angle) | rad | 0 | 2 | heading |")
+        );
         assert!(text.contains("`logStatusError`"));
         assert_eq!(m.variables[0].causality, Causality::Parameter);
     }
@@ -169,6 +189,7 @@ mod tests {
         let html = documentation_html(&m);
         assert!(html.contains("<h1>M&lt;&amp;&gt;</h1>"));
         assert!(html.contains("x &lt; y"));
+        assert!(html.contains("<td>Real (Angle)</td><td>rad</td>"));
         assert!(html.contains(&m.guid()));
     }
 }

@@ -65,7 +65,7 @@ use std::path::Path;
 
 pub use description::{
     BaseUnit, Causality, DefaultExperiment, DisplayUnit, Initial, LogCategory, ModelDescription,
-    UnitDefinition, ValueType, Variability, Variable, VariableKind,
+    SimpleType, SimpleTypeKind, UnitDefinition, ValueType, Variability, Variable, VariableKind,
 };
 pub use ffi::Fmi2Status;
 pub use logger::Logger;

@@ -39,6 +39,7 @@ fn sample() -> ModelDescription {
                 },
             ),
         ],
+        type_definitions: vec![],
         log_categories: LogCategory::standard(),
         default_experiment: DefaultExperiment {
             start_time: 0.0,
@@ -68,6 +69,24 @@ fn sample() -> ModelDescription {
     }
 }
 
+/// `sample()` with type definitions: Real `Length` (m, shown in km, range), Real `Duration`
+/// (s), Integer `Count` (quantity, range); y uses `Length`, T `Duration`, n `Count`.
+fn typed_sample() -> ModelDescription {
+    let mut md = sample();
+    md.type_definitions = vec![
+        SimpleType::real("Length", "Length", "m")
+            .with_display_unit("km")
+            .with_real_range(-1e3, 1e3)
+            .with_description("a \"length\""),
+        SimpleType::real("Duration", "Time", "s"),
+        SimpleType::integer("Count", "Count").with_integer_range(0, 1000),
+    ];
+    md.variables[1] = md.variables[1].clone().with_declared_type("Length");
+    md.variables[2] = md.variables[2].clone().with_declared_type("Duration");
+    md.variables[3] = md.variables[3].clone().with_declared_type("Count");
+    md
+}
+
 fn errors_of(md: &ModelDescription) -> Vec<String> {
     match md.validate() {
         Ok(()) => Vec::new(),
@@ -95,6 +114,45 @@ fn with_var(f: impl FnOnce(&mut Vec<Variable>)) -> ModelDescription {
 #[test]
 fn sample_is_valid() {
     assert_eq!(errors_of(&sample()), Vec::<String>::new());
+    assert_eq!(errors_of(&typed_sample()), Vec::<String>::new());
+}
+
+#[test]
+fn xml_type_definitions_order_and_attributes() {
+    let x = typed_sample().to_xml();
+    let pos = |s: &str| x.find(s).unwrap_or_else(|| panic!("{s} missing in\n{x}"));
+    let order = [
+        "<CoSimulation",
+        "<UnitDefinitions>",
+        "</UnitDefinitions>",
+        "<TypeDefinitions>",
+        "</TypeDefinitions>",
+        "<LogCategories>",
+        "<DefaultExperiment",
+        "<ModelVariables>",
+    ];
+    for w in order.windows(2) {
+        assert!(pos(w[0]) < pos(w[1]), "{} before {}", w[0], w[1]);
+    }
+    let types = "  <TypeDefinitions>\n    <SimpleType name=\"Length\" description=\"a &quot;length&quot;\">\n      <Real quantity=\"Length\" unit=\"m\" displayUnit=\"km\" min=\"-1000\" max=\"1000\"/>\n    </SimpleType>\n    <SimpleType name=\"Duration\">\n      <Real quantity=\"Time\" unit=\"s\"/>\n    </SimpleType>\n    <SimpleType name=\"Count\">\n      <Integer quantity=\"Count\" min=\"0\" max=\"1000\"/>\n    </SimpleType>\n  </TypeDefinitions>\n";
+    assert!(x.contains(types), "{x}");
+    // declaredType first; the variable keeps its own unit/displayUnit
+    assert!(x.contains("initial=\"calculated\">\n      <Real declaredType=\"Length\" unit=\"m\" displayUnit=\"km\"/>"), "{x}");
+    assert!(
+        x.contains(
+            "<Real declaredType=\"Duration\" unit=\"s\" min=\"0.001\" max=\"1000\" start=\"1.5\"/>"
+        ),
+        "{x}"
+    );
+    assert!(
+        x.contains("<Integer declaredType=\"Count\" min=\"1\" max=\"1000\" start=\"10\"/>"),
+        "{x}"
+    );
+    assert_eq!(x.matches("declaredType=").count(), 3);
+    // no types: no TypeDefinitions element
+    assert!(!sample().to_xml().contains("TypeDefinitions"));
+    assert!(!sample().to_xml().contains("declaredType"));
+    assert_ne!(typed_sample().guid(), sample().guid());
 }
 
 #[test]
@@ -117,7 +175,10 @@ fn xml_child_order_and_root_attributes() {
     assert!(x.starts_with("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"));
     assert!(x.contains("fmiVersion=\"2.0\""));
     assert!(x.contains("variableNamingConvention=\"structured\""));
-    assert!(!x.contains("TypeDefinitions"));
+    assert!(
+        !x.contains("TypeDefinitions"),
+        "empty TypeDefinitions are omitted"
+    );
     assert!(!x.contains("VendorAnnotations"));
     assert!(
         !x.contains("generationTool"),
@@ -485,6 +546,7 @@ fn rule_independent_variable() {
         variability: Variability::Continuous,
         initial: None,
         kind: VariableKind::Real {
+            declared_type: None,
             unit: None,
             display_unit: None,
             start: None,
@@ -546,6 +608,106 @@ fn rule_units_declared() {
 }
 
 #[test]
+fn rule_type_names_unique_and_non_empty() {
+    let mut md = typed_sample();
+    md.type_definitions
+        .push(SimpleType::integer("Length", "").with_description("again"));
+    assert_error(&md, "type 'Length'", "declared twice");
+    let mut md = typed_sample();
+    md.type_definitions.push(SimpleType::real("", "Mass", ""));
+    assert_error(&md, "type definition", "empty name");
+}
+
+#[test]
+fn rule_declared_type_exists_with_the_same_base_type() {
+    let md = {
+        let mut md = typed_sample();
+        md.variables[0] = md.variables[0].clone().with_declared_type("Speed");
+        md
+    };
+    assert_error(
+        &md,
+        "'u'",
+        "declaredType 'Speed' is not defined in TypeDefinitions",
+    );
+    let md = {
+        let mut md = typed_sample();
+        md.variables[3] = md.variables[3].clone().with_declared_type("Length");
+        md
+    };
+    assert_error(
+        &md,
+        "'n'",
+        "declaredType 'Length' is a Real type but the variable is Integer",
+    );
+    // also without any TypeDefinitions at all
+    let md = with_var(|v| v[7] = v[7].clone().with_declared_type("Count"));
+    assert_error(&md, "'count'", "declaredType 'Count' is not defined");
+}
+
+#[test]
+fn rule_type_units_declared() {
+    let mut md = typed_sample();
+    md.type_definitions
+        .push(SimpleType::real("Distance", "Length", "furlong"));
+    md.type_definitions
+        .push(SimpleType::real("Span", "Length", "m").with_display_unit("mile"));
+    md.type_definitions
+        .push(SimpleType::real("Ratio", "", "").with_display_unit("%"));
+    assert_error(
+        &md,
+        "type 'Distance'",
+        "unit 'furlong' is not declared in UnitDefinitions",
+    );
+    assert_error(
+        &md,
+        "type 'Span'",
+        "displayUnit 'mile' is not declared for unit 'm'",
+    );
+    assert_error(&md, "type 'Ratio'", "displayUnit '%' given without a unit");
+    // a variable without its own unit inherits the type's for its displayUnit
+    let mut md = typed_sample();
+    md.variables[0] = Variable::real_input("u", 1, "", 0.0, "")
+        .with_declared_type("Length")
+        .with_display_unit("km");
+    assert_eq!(errors_of(&md), Vec::<String>::new());
+    md.variables[0] = md.variables[0].clone().with_display_unit("mile");
+    assert_error(
+        &md,
+        "'u'",
+        "displayUnit 'mile' is not declared for unit 'm'",
+    );
+}
+
+#[test]
+fn rule_variable_unit_agrees_with_its_type() {
+    let mut md = typed_sample();
+    md.variables[6] = md.variables[6].clone().with_declared_type("Duration");
+    assert_error(
+        &md,
+        "'rate'",
+        "unit '1/s' differs from unit 's' of its declaredType 'Duration'",
+    );
+    // a variable without a unit, or a type without one, is fine
+    let mut md = typed_sample();
+    md.type_definitions.push(SimpleType::real("Any", "", ""));
+    md.variables[6] = md.variables[6].clone().with_declared_type("Any");
+    md.variables[0] = Variable::real_input("u", 1, "", 0.0, "").with_declared_type("Length");
+    assert_eq!(errors_of(&md), Vec::<String>::new());
+}
+
+#[test]
+fn rule_type_ranges() {
+    let mut md = typed_sample();
+    md.type_definitions
+        .push(SimpleType::integer("Bad", "").with_integer_range(3, 1));
+    md.type_definitions
+        .push(SimpleType::real("Wide", "", "").with_real_range(0.0, f64::INFINITY));
+    assert_error(&md, "type 'Bad'", "min 3 is greater than max 1");
+    assert_error(&md, "type 'Wide'", "max inf is not finite");
+}
+
+#[test]
 fn rule_dependencies_refer_to_existing_eligible_variables() {
     let md = with_var(|v| v[1].output_dependencies = Some(vec![99]));
     assert_error(&md, "'y'", "output dependency on value reference 99");
@@ -587,4 +749,35 @@ fn rule_dependencies_only_where_meaningful() {
 fn builder_misuse_panics_with_the_name() {
     let _ =
         Variable::integer_parameter("n", 1, 1, Variability::Fixed, "").with_real_range(0.0, 1.0);
+}
+
+#[test]
+#[should_panic(expected = "with_declared_type on non-Real/Integer variable 'flag'")]
+fn declared_type_on_boolean_panics_with_the_name() {
+    let _ = Variable::boolean_parameter("flag", 1, true, Variability::Fixed, "")
+        .with_declared_type("Count");
+}
+
+#[test]
+#[should_panic(expected = "with_declared_type on non-Real/Integer variable 'label'")]
+fn declared_type_on_string_panics_with_the_name() {
+    let _ = Variable::string_parameter("label", 1, "", "").with_declared_type("Count");
+}
+
+#[test]
+#[should_panic(expected = "with_display_unit on non-Real type 'Count'")]
+fn simple_type_builder_misuse_panics_with_the_name() {
+    let _ = SimpleType::integer("Count", "").with_display_unit("km");
+}
+
+#[test]
+fn with_declared_type_sets_real_and_integer() {
+    let v = Variable::real_output("y", 2, "m", "").with_declared_type("Length");
+    assert_eq!(v.kind.declared_type(), Some("Length"));
+    let v = Variable::integer_output("k", 2, "").with_declared_type("Count");
+    assert_eq!(v.kind.declared_type(), Some("Count"));
+    assert_eq!(
+        Variable::integer_output("k", 2, "").kind.declared_type(),
+        None
+    );
 }

@@ -63,6 +63,7 @@ pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(|| {
                 },
             ),
         ],
+        type_definitions: vec![],
         log_categories,
         default_experiment: DefaultExperiment {
             start_time: 0.0,
@@ -99,6 +100,7 @@ pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(|| {
                 variability: Variability::Constant,
                 initial: Some(Initial::Exact),
                 kind: VariableKind::Integer {
+                    declared_type: None,
                     start: Some(7),
                     min: None,
                     max: None,
