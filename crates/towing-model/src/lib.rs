@@ -6,8 +6,9 @@
 //! its controller. It holds no FFI and no `unsafe`.
 //!
 //! - [`kinetics`]: Fossen's 3-DoF manoeuvring model (Fossen 2021, eq. 6.1 / the
-//!   paper's eq. (1)) with CyberShip II (Skjetne et al. 2004) and TitoNeri hulls,
-//!   linear or nonlinear damping ([`HullModel`]).
+//!   paper's eq. (1)) with CyberShip II (Skjetne et al. 2004) and TitoNeri hulls
+//!   behind the [`HullDynamics`] trait: linear or nonlinear damping selected by
+//!   [`HullModel`], or your own hull model ([`World::with_hulls`]).
 //! - [`vessel`]: the vessel parameter structs and their sourced presets
 //!   ([`VesselData::cybership2`], [`VesselData::titoneri`]).
 //! - [`towline`]: the two towlines, forces from geometry (tension along the line,
@@ -58,7 +59,7 @@ pub mod vessel;
 pub mod world;
 
 pub use angle::wrap_angle;
-pub use kinetics::{Hull, HullModel};
+pub use kinetics::{HullDynamics, HullModel, LinearDampingHull, NonlinearDampingHull};
 pub use scenario::{
     Pose, Route, Scenario, ScenarioError, ScenarioErrorKind, TugPlacement, Waterway,
 };

@@ -300,8 +300,8 @@ impl TitoNeriDampingSet {
 /// `M_RB = [[m, 0, 0], [0, m, m x_g], [0, m x_g, I_z]]`,
 /// `M_A = -[[X_udot, 0, 0], [0, Y_vdot, Y_rdot], [0, N_vdot, N_rdot]]`;
 /// [`crate::kinetics`] uses its symmetric part. Validate with
-/// [`VesselData::validate`] (done once by [`crate::Hull::new`] and the scenario
-/// loader).
+/// [`VesselData::validate`] (done once by the hull constructors,
+/// [`crate::HullModel::build`], and by the scenario loader).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VesselData {
     /// Length overall `L` (m). Used for obstacle distances and plots.

@@ -23,11 +23,17 @@
 //! if every value is finite; otherwise [`World::step`] returns an error and the
 //! world is unchanged (the plant FMU reports `fmi2Discard`). A step allocates
 //! nothing.
+//!
+//! The hulls' kinetics are [`HullDynamics`] trait objects, one per vessel, boxed
+//! once at construction: [`World::new`] builds the built-in model that
+//! [`WorldConfig::hull_model`] selects, [`World::with_hulls`] takes your own (see
+//! [`crate::kinetics`] for how to implement one).
 
+use nalgebra::{Matrix3, Vector3};
 use thiserror::Error;
 
 use crate::angle::wrap_angle;
-use crate::kinetics::{Hull, HullModel};
+use crate::kinetics::{HullDynamics, HullModel};
 use crate::scenario::{Scenario, ScenarioError};
 use crate::towline::{
     self, clamp_command, elastic_params, elastic_tension, geometry_kin, ideal_winch_tension,
@@ -45,7 +51,9 @@ pub const MAX_SUBSTEPS: u64 = 1_000_000;
 /// Configuration of the world's physics (not part of the dynamic state).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WorldConfig {
-    /// Damping model of the hulls.
+    /// Damping model of the hulls that [`World::new`] builds. With
+    /// [`World::with_hulls`] the hulls are given and this is only a label that
+    /// enters the state fingerprint.
     pub hull_model: HullModel,
     /// Towline model.
     pub towline_model: TowlineModel,
@@ -139,6 +147,10 @@ pub enum WorldError {
     /// The configuration does not validate.
     #[error("invalid world configuration: {0}")]
     Config(ParamError),
+    /// A hull given to [`World::with_hulls`] breaks a property the world relies on
+    /// (field path `hull.ship`, `hull.tug1` or `hull.tug2` plus the quantity).
+    #[error("invalid hull model: {0}")]
+    Hull(ParamError),
 }
 
 const NX: usize = 20;
@@ -179,7 +191,8 @@ pub struct World {
     elastic: Option<ElasticTowlineParams>,
     /// Ship, tug 1, tug 2.
     data: [VesselData; 3],
-    hulls: [Hull; 3],
+    /// Kinetics of ship, tug 1, tug 2 (boxed once, at construction).
+    hulls: [Box<dyn HullDynamics>; 3],
     /// Per line: `[ship point x, tug point x]` (body, from CO).
     points: [[f64; 2]; 2],
     winch_max: [f64; 2],
@@ -196,25 +209,63 @@ pub struct World {
 
 impl World {
     /// Builds the world at `t = 0` from a scenario (re-validated, since its fields
-    /// are public) and a configuration. With the elastic line, `l0` starts at the
-    /// initial attachment distance (line just taut, zero tension).
+    /// are public) and a configuration, with the built-in hulls that
+    /// `config.hull_model` selects ([`HullModel::build`] from the scenario's vessel
+    /// data). With the elastic line, `l0` starts at the initial attachment distance
+    /// (line just taut, zero tension).
     pub fn new(scenario: &Scenario, config: WorldConfig) -> Result<World, WorldError> {
         scenario.validate()?;
         config.validate().map_err(WorldError::Config)?;
-        let data = [
-            scenario.ship_data,
-            scenario.tug_data[0],
-            scenario.tug_data[1],
-        ];
-        let hull = |i: usize, name: &str| {
-            Hull::new(&data[i], config.hull_model).map_err(|e| {
+        let data = vessel_data(scenario);
+        let hull = |i: usize| {
+            config.hull_model.build(&data[i]).map_err(|e| {
                 WorldError::Scenario(ScenarioError::invalid(
                     &scenario.origin,
-                    e.within(&format!("vessels.{name}")),
+                    e.within(&format!("vessels.{}", VESSEL_NAMES[i])),
                 ))
             })
         };
-        let hulls = [hull(0, "ship")?, hull(1, "tug1")?, hull(2, "tug2")?];
+        let hulls = [hull(0)?, hull(1)?, hull(2)?];
+        Ok(World::assemble(scenario, config, hulls))
+    }
+
+    /// Like [`World::new`], with your own hull models (see [`crate::kinetics`] for
+    /// how to implement [`HullDynamics`]): `hulls[0]` is the ship, `hulls[1]` tug 1
+    /// (aft), `hulls[2]` tug 2 (forward).
+    ///
+    /// The hulls replace only the kinetics (`M`, `C(nu)`, `D(nu)`, `nu_dot`): the
+    /// scenario's vessel data still give the towing points, the actuator and winch
+    /// limits and the dimensions (and are validated as usual), and
+    /// `config.hull_model` is then only a label that enters the state fingerprint.
+    /// Each hull is checked once: `M` finite, exactly symmetric and positive
+    /// definite, `M^-1 M = I` to 1e-9, and at a few reference velocities `C(nu)`
+    /// skew-symmetric (to 1e-9 relative), `D(nu)` and `nu_dot` finite; a failure is
+    /// [`WorldError::Hull`].
+    ///
+    /// [`World::read_state`] accepts a saved state only from a world whose hulls
+    /// have the same mass matrix and give the same `D(nu)` and `nu_dot` at those
+    /// reference points (see [`World::write_state`]).
+    pub fn with_hulls(
+        scenario: &Scenario,
+        config: WorldConfig,
+        hulls: [Box<dyn HullDynamics>; 3],
+    ) -> Result<World, WorldError> {
+        scenario.validate()?;
+        config.validate().map_err(WorldError::Config)?;
+        for (i, hull) in hulls.iter().enumerate() {
+            check_hull(&**hull)
+                .map_err(|e| WorldError::Hull(e.within(&format!("hull.{}", VESSEL_NAMES[i]))))?;
+        }
+        Ok(World::assemble(scenario, config, hulls))
+    }
+
+    /// The world from validated parts.
+    fn assemble(
+        scenario: &Scenario,
+        config: WorldConfig,
+        hulls: [Box<dyn HullDynamics>; 3],
+    ) -> World {
+        let data = vessel_data(scenario);
         let points = [
             [data[0].stern_tow_point_x, data[1].bow_tow_point_x],
             [data[0].bow_tow_point_x, data[2].stern_tow_point_x],
@@ -247,7 +298,7 @@ impl World {
             }
         }
         world.fingerprint = world.compute_fingerprint();
-        Ok(world)
+        world
     }
 
     /// Simulation time (s): the sum of all committed step sizes.
@@ -298,6 +349,20 @@ impl World {
             "tug index {i} out of range (0 = tug 1 aft, 1 = tug 2 forward)"
         );
         &self.data[1 + i]
+    }
+
+    /// The kinetics of vessel `index`: 0 ship, 1 tug 1 (aft), 2 tug 2 (forward)
+    /// (the order of [`World::with_hulls`]).
+    ///
+    /// # Panics
+    /// If `index > 2`.
+    #[must_use]
+    pub fn hull(&self, index: usize) -> &dyn HullDynamics {
+        assert!(
+            index < 3,
+            "hull index {index} out of range (0 = ship, 1 = tug 1, 2 = tug 2)"
+        );
+        &*self.hulls[index]
     }
 
     /// The obstacles of the scenario (at most [`MAX_OBSTACLES`]).
@@ -490,6 +555,8 @@ impl World {
             Kin::new([x[o], x[o + 1], x[o + 2]], [x[o + 3], x[o + 4], x[o + 5]])
         };
         let k = [kin(0), kin(1), kin(2)];
+        // [eta, nu] of vessel v are chunks 2 v and 2 v + 1.
+        let (eta_nu, _) = x.as_chunks::<3>();
         let mut forces = [[0.0; 3], tau[0], tau[1]];
         for line in 0..2 {
             let tug = 1 + line;
@@ -523,7 +590,8 @@ impl World {
             dx[o] = kv.c * kv.u - kv.s * kv.v;
             dx[o + 1] = kv.s * kv.u + kv.c * kv.v;
             dx[o + 2] = kv.r;
-            let nu_dot = self.hulls[v].nu_dot_arr([kv.u, kv.v, kv.r], forces[v]);
+            // nu straight from the state (no fresh copy: see HullDynamics::nu_dot).
+            let nu_dot = self.hulls[v].nu_dot(&eta_nu[2 * v + 1], &forces[v]);
             dx[o + 3] = nu_dot[0];
             dx[o + 4] = nu_dot[1];
             dx[o + 5] = nu_dot[2];
@@ -536,6 +604,15 @@ impl World {
     /// `b"TOWWORLD"`, `u32` version, `u64` fingerprint of the world's parameters,
     /// `f64` time, 3 x `[x, y, psi, u, v, r]` (ship, tug 1, tug 2), `f64 l0[2]`,
     /// `f64 tension[2]`, `u8 slack[2]`; [`STATE_BYTES`] bytes in all.
+    ///
+    /// The fingerprint (FNV-1a) covers the configuration (including the
+    /// `hull_model` label), the three vessels' data, the obstacles and, per hull,
+    /// its mass matrix and its `D(nu)` and `nu_dot(nu, tau)` at a fixed set of
+    /// reference points (so it also tells apart user hulls from
+    /// [`World::with_hulls`] that differ in `C`, `D` or `M^-1`). It is a check
+    /// against loading a state into the wrong world, not a proof of equality: two
+    /// hulls that agree at every reference point but differ elsewhere are not told
+    /// apart.
     pub fn write_state(&self, out: &mut Vec<u8>) {
         out.clear();
         out.reserve(STATE_BYTES);
@@ -666,6 +743,19 @@ impl World {
                 eat(&v.to_le_bytes());
             }
         }
+        for hull in &self.hulls {
+            for v in hull.mass_matrix().iter() {
+                eat(&v.to_le_bytes());
+            }
+            for (nu, tau) in HULL_REFERENCE_POINTS {
+                for v in hull.damping_matrix(&Vector3::from(nu)).iter() {
+                    eat(&v.to_le_bytes());
+                }
+                for v in hull.nu_dot(&nu, &tau) {
+                    eat(&v.to_le_bytes());
+                }
+            }
+        }
         for o in &self.obstacles {
             eat(o.name.as_bytes());
             eat(&o.x.to_le_bytes());
@@ -687,6 +777,85 @@ impl World {
         }
         h
     }
+}
+
+/// Names of ship, tug 1, tug 2 in field paths.
+const VESSEL_NAMES: [&str; 3] = ["ship", "tug1", "tug2"];
+
+fn vessel_data(scenario: &Scenario) -> [VesselData; 3] {
+    [
+        scenario.ship_data,
+        scenario.tug_data[0],
+        scenario.tug_data[1],
+    ]
+}
+
+/// `(nu, tau)` at which [`World::with_hulls`] checks a hull and the state
+/// fingerprint samples it: rest, and model-scale velocities and forces of both
+/// signs in every component.
+const HULL_REFERENCE_POINTS: [([f64; 3], [f64; 3]); 4] = [
+    ([0.0, 0.0, 0.0], [1.0, -0.5, 0.25]),
+    ([0.3, 0.05, -0.1], [2.0, 1.0, -0.5]),
+    ([-0.8, -0.4, 0.6], [-3.0, 2.0, 1.0]),
+    ([1.5, 0.8, -1.2], [5.0, -4.0, -2.0]),
+];
+
+/// The properties of a user hull the world and the energy functions rely on
+/// (see [`crate::kinetics`]).
+fn check_hull(hull: &dyn HullDynamics) -> Result<(), ParamError> {
+    let m = hull.mass_matrix();
+    if !m.iter().all(|v| v.is_finite()) {
+        return Err(ParamError::new(
+            "mass_matrix",
+            format!("must be finite, got {m}"),
+        ));
+    }
+    if *m != m.transpose() {
+        return Err(ParamError::new(
+            "mass_matrix",
+            format!("must be symmetric (use (M + M^T) / 2), got {m}"),
+        ));
+    }
+    if m.cholesky().is_none() {
+        return Err(ParamError::new(
+            "mass_matrix",
+            format!("must be positive definite, got {m}"),
+        ));
+    }
+    let inv = hull.mass_matrix_inv();
+    let error = (inv * m - Matrix3::identity()).abs().max();
+    if !inv.iter().all(|v| v.is_finite()) || error > 1e-9 {
+        return Err(ParamError::new(
+            "mass_matrix_inv",
+            format!("must be the inverse of the mass matrix (|M^-1 M - I| = {error:e})"),
+        ));
+    }
+    for (nu, tau) in HULL_REFERENCE_POINTS {
+        let nu_v = Vector3::from(nu);
+        let c = hull.coriolis_matrix(&nu_v);
+        let asym = (c + c.transpose()).abs().max();
+        if !c.iter().all(|v| v.is_finite()) || asym > 1e-9 * (1.0 + c.abs().max()) {
+            return Err(ParamError::new(
+                "coriolis_matrix",
+                format!("must be finite and skew-symmetric, got {c} at nu = {nu:?}"),
+            ));
+        }
+        let d = hull.damping_matrix(&nu_v);
+        if !d.iter().all(|v| v.is_finite()) {
+            return Err(ParamError::new(
+                "damping_matrix",
+                format!("must be finite, got {d} at nu = {nu:?}"),
+            ));
+        }
+        let nu_dot = hull.nu_dot(&nu, &tau);
+        if !nu_dot.iter().all(|v| v.is_finite()) {
+            return Err(ParamError::new(
+                "nu_dot",
+                format!("must be finite, got {nu_dot:?} at nu = {nu:?}, tau = {tau:?}"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn normalised(mut s: VesselState) -> VesselState {

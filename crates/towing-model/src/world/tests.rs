@@ -1,4 +1,5 @@
 use super::*;
+use crate::kinetics::NonlinearDampingHull;
 use crate::traffic::{KIND_CIRCLE, KIND_NONE, KIND_VESSEL};
 use nalgebra::Vector3;
 use proptest::prelude::*;
@@ -527,7 +528,7 @@ fn kinetic_energies(w: &World, config: WorldConfig) -> [f64; 3] {
     let states = [*w.ship(), *w.tug(0), *w.tug(1)];
     let mut out = [0.0; 3];
     for i in 0..3 {
-        let hull = Hull::new(&data[i], config.hull_model).unwrap();
+        let hull = config.hull_model.build(&data[i]).unwrap();
         out[i] = hull.kinetic_energy(&Vector3::from(states[i].nu));
     }
     out
@@ -632,4 +633,351 @@ fn bench_scenario_has_eight_active_obstacles() {
         assert_ne!(w.obstacle(slot).kind, KIND_NONE, "slot {slot}");
     }
     assert_eq!(w.config().hull_model, HullModel::NonlinearDamping);
+}
+
+fn builtin_hulls(scenario: &Scenario, model: HullModel) -> [Box<dyn HullDynamics>; 3] {
+    [
+        model.build(&scenario.ship_data).unwrap(),
+        model.build(&scenario.tug_data[0]).unwrap(),
+        model.build(&scenario.tug_data[1]).unwrap(),
+    ]
+}
+
+/// Ship, tug 1 and tug 2 states after 200 steps of `Inputs(11)` from BASE, for
+/// each of `configs()`, recorded (as bits) from the pre-trait implementation.
+const PINNED_TRAJECTORY_ENDS: [[u64; 18]; 4] = [
+    [
+        4594804616932409817,
+        13829204579104367791,
+        4603073373245058545,
+        13814066627394855902,
+        13802530172718572190,
+        4583273464977373616,
+        13823026253125373904,
+        13826571835901350804,
+        13833650317966607502,
+        4583139333844473246,
+        13788577689728979389,
+        13817170915269402415,
+        4607663437542256465,
+        13824400167855588925,
+        4593261005023507078,
+        4586197077676273593,
+        4569747681749289031,
+        4598520169323776778,
+    ],
+    [
+        4598974170941302126,
+        13823675419775475777,
+        4603456760292218557,
+        13807007173334700994,
+        13810990855535793177,
+        4581169855506530897,
+        13826369845481738876,
+        13822734257289209317,
+        13829866907917793906,
+        4583551553358198487,
+        13783554888880038430,
+        13816160060484197427,
+        4608533590357918736,
+        4594989855718218662,
+        4600074205465088835,
+        13799794336870068431,
+        4564943455769422537,
+        4590531831208421097,
+    ],
+    [
+        4592041056146074929,
+        13828746188974667602,
+        4603690231407135470,
+        13814986415022991050,
+        13808361272082370569,
+        4592636736313840942,
+        13823447415609950903,
+        13825149411473461973,
+        13833960846926454604,
+        13806903305476815951,
+        13794939201624150488,
+        13817739039691883717,
+        4607611200710495918,
+        13823215624043943318,
+        4595224345942931595,
+        4581090701571648346,
+        4567564942275356424,
+        4598881176609644617,
+    ],
+    [
+        4598729355265921880,
+        13823256008687956826,
+        4603262016188717551,
+        13806811880859179118,
+        13809473661969211022,
+        4575650902130522139,
+        13826622231450248643,
+        13822252233231033087,
+        13829673691998239020,
+        4582200954250920962,
+        13784833885893688487,
+        13815716777168162469,
+        4608510767151660964,
+        4595201988156554173,
+        4599899534795325226,
+        13798877613390652018,
+        4564917634816481091,
+        4589756720492525038,
+    ],
+];
+
+fn vessel_bits(w: &World) -> Vec<u64> {
+    [*w.ship(), *w.tug(0), *w.tug(1)]
+        .iter()
+        .flat_map(|s| s.eta.iter().chain(s.nu.iter()).map(|v| v.to_bits()))
+        .collect()
+}
+
+/// Both hull models through the trait objects reproduce the former trajectories
+/// bit for bit, with `World::new` and with `World::with_hulls` given the same
+/// built-in hulls.
+#[test]
+fn trajectories_are_unchanged_by_the_hull_trait() {
+    let s = scenario(BASE);
+    for (config, expected) in configs().into_iter().zip(PINNED_TRAJECTORY_ENDS) {
+        let mut a = World::new(&s, config).unwrap();
+        let mut b = World::with_hulls(&s, config, builtin_hulls(&s, config.hull_model)).unwrap();
+        assert_eq!(state_bytes(&a), state_bytes(&b), "same fingerprint");
+        let mut inputs = Inputs(11);
+        for _ in 0..200 {
+            let i = inputs.next();
+            a.step(&i, 0.1).unwrap();
+            b.step(&i, 0.1).unwrap();
+            assert_eq!(state_bytes(&a), state_bytes(&b));
+        }
+        assert_eq!(vessel_bits(&a), expected, "{config:?}");
+    }
+}
+
+/// A user hull: CyberShip II with twice the identified (nonlinear) damping. Keeps
+/// the trait's defaults for C, nu_dot and the energies.
+#[derive(Debug, Clone)]
+struct DoubledDamping(NonlinearDampingHull);
+
+impl HullDynamics for DoubledDamping {
+    fn mass_matrix(&self) -> &Matrix3<f64> {
+        self.0.mass_matrix()
+    }
+    fn mass_matrix_inv(&self) -> &Matrix3<f64> {
+        self.0.mass_matrix_inv()
+    }
+    fn damping_matrix(&self, nu: &Vector3<f64>) -> Matrix3<f64> {
+        self.0.damping_matrix(nu) * 2.0
+    }
+    fn clone_box(&self) -> Box<dyn HullDynamics> {
+        Box::new(self.clone())
+    }
+}
+
+fn doubled_damping_hulls(s: &Scenario) -> [Box<dyn HullDynamics>; 3] {
+    let [_, tug1, tug2] = builtin_hulls(s, HullModel::NonlinearDamping);
+    [
+        Box::new(DoubledDamping(
+            NonlinearDampingHull::new(&s.ship_data).unwrap(),
+        )),
+        tug1,
+        tug2,
+    ]
+}
+
+/// Tug 2 tows with 2 N for 300 s: the identified ship reaches the steady speed of
+/// 2 N (0.579 m/s, vessels.md), the doubled-damping ship that of 1 N (0.426 m/s,
+/// since 2 d11(u) u = 2 N), both within 1 %, and is slower all the way.
+#[test]
+fn user_hull_with_doubled_damping_tows_slower() {
+    let s = scenario(BASE);
+    let config = WorldConfig::default();
+    let mut identified = World::new(&s, config).unwrap();
+    let mut doubled = World::with_hulls(&s, config, doubled_damping_hulls(&s)).unwrap();
+    assert_eq!(
+        doubled.hull(0).damping_matrix(&Vector3::new(0.5, 0.0, 0.0))[(0, 0)],
+        2.0 * identified
+            .hull(0)
+            .damping_matrix(&Vector3::new(0.5, 0.0, 0.0))[(0, 0)]
+    );
+    let inputs = WorldInputs {
+        tug_tau: [[0.0; 3], [5.0, 0.0, 0.0]],
+        tension_cmd: [0.0, 2.0],
+    };
+    for _ in 0..3000 {
+        identified.step(&inputs, 0.1).unwrap();
+        doubled.step(&inputs, 0.1).unwrap();
+        assert_eq!(doubled.towline(1).tension, 2.0);
+        assert!(doubled.ship().nu[0] < identified.ship().nu[0]);
+        assert!(doubled.ship().eta[0] < identified.ship().eta[0]);
+    }
+    let (u_identified, u_doubled) = (identified.ship().nu[0], doubled.ship().nu[0]);
+    assert!(
+        (u_identified - 0.579).abs() < 0.01 * 0.579,
+        "{u_identified}"
+    );
+    assert!((u_doubled - 0.426).abs() < 0.01 * 0.426, "{u_doubled}");
+    // Still a straight tow.
+    assert_eq!(
+        (
+            doubled.ship().nu[1],
+            doubled.ship().nu[2],
+            doubled.ship().eta[2]
+        ),
+        (0.0, 0.0, 0.0)
+    );
+}
+
+/// Everything else works with user hulls: determinism, cloning, state round trip,
+/// and the fingerprint tells the worlds apart.
+#[test]
+fn user_hulls_are_deterministic_and_round_trip_the_state() {
+    let s = scenario(BASE);
+    for config in configs() {
+        let mut a = World::with_hulls(&s, config, doubled_damping_hulls(&s)).unwrap();
+        let mut b = World::with_hulls(&s, config, doubled_damping_hulls(&s)).unwrap();
+        let mut inputs = Inputs(5);
+        for _ in 0..30 {
+            let i = inputs.next();
+            a.step(&i, 0.1).unwrap();
+            b.step(&i, 0.1).unwrap();
+            assert_eq!(state_bytes(&a), state_bytes(&b), "{config:?}");
+        }
+        let saved = state_bytes(&a);
+        let rng_state = inputs.0;
+        let mut clone = a.clone();
+        let mut trajectory = Vec::new();
+        for _ in 0..30 {
+            let i = inputs.next();
+            a.step(&i, 0.1).unwrap();
+            clone.step(&i, 0.1).unwrap();
+            trajectory.push(state_bytes(&a));
+            assert_eq!(state_bytes(&clone), state_bytes(&a));
+        }
+        let mut c = World::with_hulls(&s, config, doubled_damping_hulls(&s)).unwrap();
+        c.read_state(&saved).unwrap();
+        assert_eq!(state_bytes(&c), saved);
+        let mut inputs = Inputs(rng_state);
+        for expected in &trajectory {
+            c.step(&inputs.next(), 0.1).unwrap();
+            assert_eq!(&state_bytes(&c), expected, "{config:?}");
+        }
+        // The built-in hulls (same scenario and configuration) refuse the state,
+        // and the user-hull world refuses theirs.
+        let mut builtin = World::new(&s, config).unwrap();
+        let builtin_state = state_bytes(&builtin);
+        assert!(builtin
+            .read_state(&saved)
+            .unwrap_err()
+            .contains("different scenario or configuration"));
+        assert!(c
+            .read_state(&builtin_state)
+            .unwrap_err()
+            .contains("different scenario or configuration"));
+    }
+    // The hull_model label is part of the configuration fingerprint.
+    let linear = WorldConfig {
+        hull_model: HullModel::LinearDamping,
+        ..WorldConfig::default()
+    };
+    let saved = state_bytes(&World::with_hulls(&s, linear, doubled_damping_hulls(&s)).unwrap());
+    let mut other =
+        World::with_hulls(&s, WorldConfig::default(), doubled_damping_hulls(&s)).unwrap();
+    assert!(other.read_state(&saved).is_err());
+}
+
+/// A hull with given matrices, for the checks of `World::with_hulls`.
+#[derive(Debug, Clone)]
+struct MatrixHull {
+    m: Matrix3<f64>,
+    m_inv: Matrix3<f64>,
+    skew_c: bool,
+}
+
+impl HullDynamics for MatrixHull {
+    fn mass_matrix(&self) -> &Matrix3<f64> {
+        &self.m
+    }
+    fn mass_matrix_inv(&self) -> &Matrix3<f64> {
+        &self.m_inv
+    }
+    fn damping_matrix(&self, _nu: &Vector3<f64>) -> Matrix3<f64> {
+        Matrix3::identity()
+    }
+    fn coriolis_matrix(&self, nu: &Vector3<f64>) -> Matrix3<f64> {
+        let c = crate::kinetics::C(&self.m, nu);
+        if self.skew_c {
+            c
+        } else {
+            c.abs()
+        }
+    }
+    fn clone_box(&self) -> Box<dyn HullDynamics> {
+        Box::new(self.clone())
+    }
+}
+
+#[test]
+fn with_hulls_refuses_hulls_that_break_the_documented_properties() {
+    let s = scenario(BASE);
+    let good = VesselData::titoneri().mass_matrix();
+    let hull = |m: Matrix3<f64>, m_inv: Matrix3<f64>, skew_c: bool| -> Box<dyn HullDynamics> {
+        Box::new(MatrixHull { m, m_inv, skew_c })
+    };
+    let good_inv = good.try_inverse().unwrap();
+    let mut asymmetric = good;
+    asymmetric[(1, 2)] += 0.1;
+    let indefinite = Matrix3::new(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 1.0);
+    let cases = [
+        (hull(good, good_inv, true), None),
+        (
+            hull(asymmetric, asymmetric.try_inverse().unwrap(), true),
+            Some("hull.tug2.mass_matrix"),
+        ),
+        (
+            hull(indefinite, indefinite, true),
+            Some("hull.tug2.mass_matrix"),
+        ),
+        (
+            hull(good, good_inv * 1.01, true),
+            Some("hull.tug2.mass_matrix_inv"),
+        ),
+        (
+            hull(good, good_inv, false),
+            Some("hull.tug2.coriolis_matrix"),
+        ),
+    ];
+    for (tug2, expected) in cases {
+        let [ship, tug1, _] = builtin_hulls(&s, HullModel::NonlinearDamping);
+        match (
+            World::with_hulls(&s, WorldConfig::default(), [ship, tug1, tug2]),
+            expected,
+        ) {
+            (Ok(w), None) => assert!(format!("{:?}", w.hull(2)).contains("MatrixHull")),
+            (Err(WorldError::Hull(e)), Some(field)) => {
+                assert_eq!(e.field, field, "{e}");
+                assert!(WorldError::Hull(e)
+                    .to_string()
+                    .starts_with("invalid hull model"));
+            }
+            (other, _) => panic!("{other:?}"),
+        }
+    }
+    // The scenario and the configuration are still validated.
+    let config = WorldConfig {
+        integration_step: 0.0,
+        ..WorldConfig::default()
+    };
+    assert!(matches!(
+        World::with_hulls(&s, config, builtin_hulls(&s, HullModel::LinearDamping)),
+        Err(WorldError::Config(_))
+    ));
+}
+
+#[test]
+#[should_panic(expected = "hull index 3 out of range")]
+fn hull_index_beyond_the_tugs_panics() {
+    let _ = world_with(BASE, WorldConfig::default()).hull(3);
 }
