@@ -1,0 +1,980 @@
+//! The ship reference system: Du et al. (2022), section 3.1, eq. (8)-(11), with the
+//! COLREGS policy of [`crate::colregs`] deciding which obstacles may alter the route.
+//!
+//! Per sample ([`ReferenceSystem::update`]):
+//! 1. Every active obstacle is assessed ([`assess_obstacle`]): its range-equivalent
+//!    distance to the nearest of the three vessels (ship, tug 1, tug 2; eq. (8)'s
+//!    `min{d_Sj, d_1j, d_2j}`), its eq. (9) distance and eq. (14) safe distance
+//!    for that vessel, and for a target ship the COLREGS encounter and policy.
+//!    A target's situation is *held* from the first sample it is detected with a
+//!    definite situation (not safe, not unclassified) until its encounter is over:
+//!    roles are fixed when risk first exists, and Rule 13(d): "any subsequent
+//!    alteration of the bearing ... shall not make the overtaking vessel a crossing
+//!    vessel". Without it a target crossing ahead of a stand-on tow turns into an
+//!    "overtaken" vessel on the tow's starboard bow once it has crossed.
+//! 2. An obstacle *demands* the alteration when it is within its detection
+//!    distance (eq. (8): `d <= d_D`) and its policy alters to starboard now: a static
+//!    hazard by distance (the paper's rule) if the altered leg passes it farther
+//!    than the route does ([`StaticHazardPolicy::WhenAlteringHelps`], the default;
+//!    [`StaticHazardPolicy::ByDistance`] drops that test), a target ship if its
+//!    action is
+//!    [`Action::AlterToStarboard`] or [`Action::KeepOut`], or
+//!    [`Action::StandOnThenAct`] once Rule 17 allows action
+//!    ([`crate::Rule17Settings`]). A stand-on tow keeps the route until then.
+//! 3. An obstacle that demanded the alteration keeps it until its distance exceeds
+//!    its detection distance plus `release_margin` (for a static hazard: or the
+//!    alteration no longer helps, on a new segment) (the encounter is over; Rule
+//!    8(d): "until the other vessel is finally past and clear"), even if its
+//!    situation has meanwhile become safe.
+//! 4. While any obstacle keeps it, the reference is the active waypoint rotated to
+//!    starboard about the previous predefined waypoint (eq. (10)-(11)); otherwise the
+//!    predefined waypoint (eq. (8), `eta_Sd = eta_Sp`).
+//! 5. The active waypoint advances when the ship reaches the reference waypoint
+//!    (acceptance radius) or has passed it; the destination is held.
+
+use serde::{Deserialize, Serialize};
+
+use crate::colregs::{action, classify, Action, Encounter, Manoeuvre, Situation};
+use crate::distance::{Obstacle, ObstacleInput, ObstacleKind};
+use crate::error::InputError;
+use crate::geometry::{dist, segment_distance};
+use crate::params::{GuidanceParams, StaticHazardPolicy};
+use crate::waypoint::{rotate_waypoint, theta_max, Pose, Route};
+
+/// Largest number of obstacle slots [`ReferenceSystem::update`] accepts (the
+/// encounters are tracked in a 64-bit mask, without allocation).
+pub const MAX_OBSTACLES: usize = 64;
+
+/// State of the tow at a sample, as the controller sees it.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct TowState {
+    /// Ship pose `eta_S` (m, m, rad).
+    pub ship: Pose,
+    /// Ship velocity over ground in NED (m/s); from body `nu` use
+    /// [`crate::body_to_ned`]. Used for the CPA and the speed comparison of Rule 13.
+    pub ship_vel_n: [f64; 2],
+    /// Tug 1 (aft) pose; only the position is used.
+    pub tug1: Pose,
+    /// Tug 2 (forward) pose; only the position is used.
+    pub tug2: Pose,
+}
+
+impl TowState {
+    fn validate(&self) -> Result<(), InputError> {
+        let fields = [
+            ("ship.x", self.ship.x),
+            ("ship.y", self.ship.y),
+            ("ship.psi", self.ship.psi),
+            ("ship_vel_n[0]", self.ship_vel_n[0]),
+            ("ship_vel_n[1]", self.ship_vel_n[1]),
+            ("tug1.x", self.tug1.x),
+            ("tug1.y", self.tug1.y),
+            ("tug2.x", self.tug2.x),
+            ("tug2.y", self.tug2.y),
+        ];
+        for (field, value) in fields {
+            if !value.is_finite() {
+                return Err(InputError::NonFiniteTowState { field });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One of the three vessels of the tow.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum TowVessel {
+    /// The towed ship.
+    Ship,
+    /// Tug 1, aft.
+    Tug1,
+    /// Tug 2, forward.
+    Tug2,
+}
+
+/// What the reference system found about one obstacle at one sample.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ObstacleAssessment {
+    /// Slot index in the obstacle slice.
+    pub index: usize,
+    /// Circle or vessel.
+    pub kind: ObstacleKind,
+    /// The vessel of the tow nearest to it (range-equivalent distance).
+    pub nearest_vessel: TowVessel,
+    /// Range-equivalent distance (m) from the nearest vessel: centre distance for
+    /// a circle, half the focal sum for a ship (see [`crate::distance`]).
+    pub range: f64,
+    /// Eq. (9) distance (m) from the nearest vessel: centre distance or focal sum.
+    pub distance_eq9: f64,
+    /// Eq. (14) safe distance (m) of the nearest vessel, units of `distance_eq9`.
+    pub safe_distance_eq14: f64,
+    /// COLREGS encounter of the ship with this target at this sample (its
+    /// `situation` from the present geometry); `None` for static hazards.
+    pub encounter: Option<Encounter>,
+    /// The situation the policy is taken from: the held one of the encounter if
+    /// any, else the present one; `None` for static hazards.
+    pub situation: Option<Situation>,
+    /// The policy: for a target ship [`crate::action`] of `situation`; for a
+    /// static hazard [`Action::AlterToStarboard`] (the paper's by-distance rule).
+    pub action: Action,
+    /// Within its detection distance (`d_D`, or the static hazards' distance).
+    pub detected: bool,
+    /// Whether a starboard alteration may be asked for: for a static hazard under
+    /// [`StaticHazardPolicy::WhenAlteringHelps`], true when the altered leg passes
+    /// its centre farther than the route's leg; true otherwise.
+    pub alteration_allowed: bool,
+    /// What it asks of the reference system now (detection and Rule 17 applied).
+    pub manoeuvre: Manoeuvre,
+}
+
+/// What the reference system knows beyond the obstacle and the tow.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct AssessContext {
+    /// The situation held for this encounter, if any (ignored for static hazards).
+    pub held: Option<Situation>,
+    /// The active leg: `[W_{p-1}, W_p, W_pN]` positions (m), the previous and the
+    /// active predefined waypoint and the altered one. Needed by
+    /// [`StaticHazardPolicy::WhenAlteringHelps`]; without it a static hazard is
+    /// judged by distance only.
+    pub leg: Option<[[f64; 2]; 3]>,
+}
+
+/// Assesses one active obstacle for the tow (steps 1 and 2 of the module doc).
+#[must_use]
+pub fn assess_obstacle(
+    params: &GuidanceParams,
+    tow: &TowState,
+    index: usize,
+    obstacle: &Obstacle,
+    context: &AssessContext,
+) -> ObstacleAssessment {
+    let s = params.settings();
+    let vessels = [
+        (TowVessel::Ship, tow.ship.position(), s.ship_length),
+        (TowVessel::Tug1, tow.tug1.position(), s.tug_length),
+        (TowVessel::Tug2, tow.tug2.position(), s.tug_length),
+    ];
+    let mut nearest = vessels[0];
+    let mut range = obstacle.range(nearest.1);
+    for v in &vessels[1..] {
+        let r = obstacle.range(v.1);
+        if r < range {
+            range = r;
+            nearest = *v;
+        }
+    }
+    let (encounter, situation, policy, detection) = match obstacle {
+        Obstacle::Circle { .. } => (
+            None,
+            None,
+            Action::AlterToStarboard,
+            s.static_detection_distance,
+        ),
+        Obstacle::Vessel(target) => {
+            let enc = classify(
+                tow.ship,
+                tow.ship_vel_n,
+                target,
+                &s.colregs.thresholds,
+                s.colregs.risk_dcpa,
+            );
+            let situation = context.held.unwrap_or(enc.situation);
+            (
+                Some(enc),
+                Some(situation),
+                action(situation, s.colregs.tow_status),
+                s.detection_distance,
+            )
+        }
+    };
+    let detected = range <= detection;
+    let alteration_allowed = match (obstacle, s.static_hazard_policy, context.leg) {
+        (Obstacle::Circle { centre, .. }, StaticHazardPolicy::WhenAlteringHelps, Some(leg)) => {
+            segment_distance(*centre, leg[0], leg[2]) > segment_distance(*centre, leg[0], leg[1])
+        }
+        _ => true,
+    };
+    let manoeuvre = match (detected && alteration_allowed, &encounter) {
+        (false, _) => Manoeuvre::FollowRoute,
+        (true, None) => Manoeuvre::AlterToStarboard,
+        (true, Some(enc)) => policy.manoeuvre(&enc.cpa, &s.colregs.rule17),
+    };
+    ObstacleAssessment {
+        index,
+        kind: obstacle.kind(),
+        nearest_vessel: nearest.0,
+        range,
+        distance_eq9: obstacle.distance_eq9(nearest.1),
+        safe_distance_eq14: obstacle.safe_distance_eq14(nearest.2, s.safety_buffer),
+        encounter,
+        situation,
+        action: policy,
+        detected,
+        alteration_allowed,
+        manoeuvre,
+    }
+}
+
+/// Output of one sample.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GuidanceOutput {
+    /// Reference pose `eta_Sd = [x, y, psi]` for the controller (eq. (8)).
+    pub eta_sd: Pose,
+    /// The predefined (unaltered) active waypoint `eta_Sp`.
+    pub route_waypoint: Pose,
+    /// Index of the active waypoint in [`Route::points`] (1 = `W_P1`; the last is
+    /// the destination).
+    pub active_waypoint: usize,
+    /// True when `eta_Sd` is the altered waypoint `eta_Sn` (eq. (10)-(11)).
+    pub altered: bool,
+    /// Altering angle applied (rad): `min(theta, theta_max)` when altered, else 0.
+    pub theta: f64,
+    /// `d_ob` (m): smallest range-equivalent distance between the tow and any
+    /// active obstacle (eq. (8)); `+inf` without obstacles.
+    pub d_ob: f64,
+    /// The governing obstacle: while altered, the nearest of those keeping the
+    /// alteration; otherwise the nearest obstacle (the one giving `d_ob`).
+    pub governing: Option<ObstacleAssessment>,
+}
+
+/// The ship reference system: route, active waypoint and the encounters that
+/// altered it. Allocation-free per sample.
+///
+/// ```
+/// use towing_guidance::{GuidanceParams, ObstacleInput, Pose, ReferenceSystem, Route, TowState};
+///
+/// let mut guidance = ReferenceSystem::new(Route::paper(), GuidanceParams::default());
+/// let ship = Pose::from_deg(-4.9, 7.0, 101.3);
+/// let ahead = |d: f64| Pose { x: ship.x + d * ship.psi.cos(), y: ship.y + d * ship.psi.sin(), ..ship };
+/// let tow = TowState { ship, ship_vel_n: [-0.02, 0.098], tug1: ahead(-2.17), tug2: ahead(2.085) };
+/// // A target ship 5 m ahead of tug 2 on the reciprocal course: head-on.
+/// let target = ahead(7.085);
+/// let obstacles = [ObstacleInput {
+///     x: target.x, y: target.y, psi: ship.psi + std::f64::consts::PI,
+///     speed: 0.07, length: 1.48, width: 0.48, kind: 2,
+/// }];
+/// let out = guidance.update(&tow, &obstacles)?;
+/// assert!(out.altered);
+/// assert!((out.eta_sd.psi - 116.3f64.to_radians()).abs() < 1e-9); // 101.3 + 15 deg
+/// # Ok::<(), towing_guidance::InputError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct ReferenceSystem {
+    route: Route,
+    params: GuidanceParams,
+    active: usize,
+    latched: u64,
+    held: [Option<Situation>; MAX_OBSTACLES],
+}
+
+impl ReferenceSystem {
+    /// A reference system at the start of `route` (active waypoint 1).
+    #[must_use]
+    pub fn new(route: Route, params: GuidanceParams) -> Self {
+        Self {
+            route,
+            params,
+            active: 1,
+            latched: 0,
+            held: [None; MAX_OBSTACLES],
+        }
+    }
+
+    /// Back to the start of the route, no encounter.
+    pub fn reset(&mut self) {
+        self.active = 1;
+        self.latched = 0;
+        self.held = [None; MAX_OBSTACLES];
+    }
+
+    /// The route.
+    #[must_use]
+    pub fn route(&self) -> &Route {
+        &self.route
+    }
+
+    /// The parameters.
+    #[must_use]
+    pub fn params(&self) -> &GuidanceParams {
+        &self.params
+    }
+
+    /// Index of the active waypoint.
+    #[must_use]
+    pub fn active_waypoint(&self) -> usize {
+        self.active
+    }
+
+    /// True while an encounter keeps the route altered.
+    #[must_use]
+    pub fn is_altered(&self) -> bool {
+        self.latched != 0
+    }
+
+    /// Altering angle of segment `p`: `theta`, bounded by `theta_max` (remark on
+    /// the choice of `theta`).
+    fn theta(&self, p: usize) -> f64 {
+        let s = self.params.settings();
+        match s.waterway_half_width {
+            Some(d2) => s
+                .altering_angle
+                .min(theta_max(self.route.segment_length(p), d2)),
+            None => s.altering_angle,
+        }
+    }
+
+    /// Reference waypoint of segment `p` and the angle applied.
+    fn reference(&self, p: usize, altered: bool) -> (Pose, f64) {
+        let points = self.route.points();
+        if altered {
+            let theta = self.theta(p);
+            (rotate_waypoint(points[p - 1], points[p], theta), theta)
+        } else {
+            (points[p], 0.0)
+        }
+    }
+
+    fn reached(&self, ship: [f64; 2], p: usize, target: Pose) -> bool {
+        let s = self.params.settings();
+        if dist(ship, target.position()) <= s.acceptance_radius {
+            return true;
+        }
+        if !s.advance_on_passing {
+            return false;
+        }
+        let prev = self.route.points()[p - 1];
+        let seg = [target.x - prev.x, target.y - prev.y];
+        let r = seg[0].hypot(seg[1]);
+        let along = ((ship[0] - prev.x) * seg[0] + (ship[1] - prev.y) * seg[1]) / r;
+        along >= r
+    }
+
+    /// One sample: assess the obstacles (slot `k` of `obstacles` is obstacle `k`;
+    /// kind 0 slots are ignored), update the encounter state and the active
+    /// waypoint, and return the reference.
+    ///
+    /// # Errors
+    /// A non-finite tow state, more than [`MAX_OBSTACLES`] slots, or an invalid
+    /// active obstacle ([`ObstacleInput::obstacle`]). The state is then unchanged.
+    pub fn update(
+        &mut self,
+        tow: &TowState,
+        obstacles: &[ObstacleInput],
+    ) -> Result<GuidanceOutput, InputError> {
+        tow.validate()?;
+        if obstacles.len() > MAX_OBSTACLES {
+            return Err(InputError::TooManyObstacles {
+                count: obstacles.len(),
+                max: MAX_OBSTACLES,
+            });
+        }
+        let s = self.params.settings();
+        let mut d_ob = f64::INFINITY;
+        let mut nearest: Option<ObstacleAssessment> = None;
+        let mut nearest_latched: Option<ObstacleAssessment> = None;
+        let mut latched = 0u64;
+        let mut held = [None; MAX_OBSTACLES];
+        let points = self.route.points();
+        let leg = [
+            points[self.active - 1].position(),
+            points[self.active].position(),
+            self.reference(self.active, true).0.position(),
+        ];
+        for (index, input) in obstacles.iter().enumerate() {
+            let Some(obstacle) = input.obstacle()? else {
+                continue;
+            };
+            let held_before = match obstacle {
+                Obstacle::Vessel(_) => self.held[index],
+                Obstacle::Circle { .. } => None,
+            };
+            let context = AssessContext {
+                held: held_before,
+                leg: Some(leg),
+            };
+            let a = assess_obstacle(&self.params, tow, index, &obstacle, &context);
+            if a.range < d_ob {
+                d_ob = a.range;
+                nearest = Some(a);
+            }
+            let bit = 1u64 << index;
+            let detection = match a.kind {
+                ObstacleKind::Circle => s.static_detection_distance,
+                _ => s.detection_distance,
+            };
+            let in_encounter = a.range <= detection + s.release_margin;
+            if let (true, Some(enc)) = (in_encounter, a.encounter) {
+                let definite = !matches!(enc.situation, Situation::Safe | Situation::Unclassified);
+                held[index] = held_before.or((a.detected && definite).then_some(enc.situation));
+            }
+            let demands = a.manoeuvre == Manoeuvre::AlterToStarboard;
+            let keeps = self.latched & bit != 0 && in_encounter && a.alteration_allowed;
+            if demands || keeps {
+                latched |= bit;
+                if nearest_latched.is_none_or(|n| a.range < n.range) {
+                    nearest_latched = Some(a);
+                }
+            }
+        }
+        self.latched = latched;
+        self.held = held;
+        let altered = latched != 0;
+
+        let ship = tow.ship.position();
+        let last = self.route.last_index();
+        let (mut target, mut theta) = self.reference(self.active, altered);
+        while self.active < last && self.reached(ship, self.active, target) {
+            self.active += 1;
+            (target, theta) = self.reference(self.active, altered);
+        }
+        Ok(GuidanceOutput {
+            eta_sd: target,
+            route_waypoint: self.route.points()[self.active],
+            active_waypoint: self.active,
+            altered,
+            theta,
+            d_ob,
+            governing: if altered { nearest_latched } else { nearest },
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::colregs::Situation;
+    use crate::params::{GuidanceSettings, StaticHazardPolicy};
+    use std::f64::consts::PI;
+
+    /// Forward tug CG ahead of the ship CG: l_2 + l_tow2 + l_T2 (Table 2).
+    const TUG2_AHEAD: f64 = 0.585 + 1.0 + 0.5;
+    /// Aft tug CG astern of the ship CG: l_1 + l_tow1 + l_T1.
+    const TUG1_ASTERN: f64 = 0.67 + 1.0 + 0.5;
+
+    fn deg(d: f64) -> f64 {
+        d.to_radians()
+    }
+
+    /// The tow in line at `ship`, moving along its heading at `speed`.
+    fn tow_at(ship: Pose, speed: f64) -> TowState {
+        let (s, c) = ship.psi.sin_cos();
+        let at = |d: f64| Pose::new(ship.x + d * c, ship.y + d * s, ship.psi);
+        TowState {
+            ship,
+            ship_vel_n: [speed * c, speed * s],
+            tug1: at(-TUG1_ASTERN),
+            tug2: at(TUG2_AHEAD),
+        }
+    }
+
+    /// Moves the ship `speed * dt` straight towards `target` (kinematic tow).
+    fn step_towards(tow: &TowState, target: Pose, speed: f64, dt: f64) -> TowState {
+        let d = [target.x - tow.ship.x, target.y - tow.ship.y];
+        let len = d[0].hypot(d[1]);
+        if len < 1e-9 {
+            return tow_at(tow.ship, 0.0);
+        }
+        let psi = d[1].atan2(d[0]);
+        let step = (speed * dt).min(len);
+        tow_at(
+            Pose::new(
+                tow.ship.x + step * psi.cos(),
+                tow.ship.y + step * psi.sin(),
+                psi,
+            ),
+            step / dt,
+        )
+    }
+
+    fn vessel(x: f64, y: f64, psi: f64, speed: f64) -> ObstacleInput {
+        ObstacleInput {
+            x,
+            y,
+            psi,
+            speed,
+            length: 1.48,
+            width: 0.48,
+            kind: 2,
+        }
+    }
+
+    fn circle(x: f64, y: f64, diameter: f64) -> ObstacleInput {
+        ObstacleInput {
+            x,
+            y,
+            length: diameter,
+            width: diameter,
+            kind: 1,
+            ..ObstacleInput::default()
+        }
+    }
+
+    /// A northbound route (0,0) -> (30,0) -> (60,0).
+    fn north_route() -> Route {
+        Route::from_positions(&[[0.0, 0.0], [30.0, 0.0], [60.0, 0.0]]).unwrap()
+    }
+
+    fn moved(o: ObstacleInput, dt: f64) -> ObstacleInput {
+        ObstacleInput {
+            x: o.x + o.speed * dt * o.psi.cos(),
+            y: o.y + o.speed * dt * o.psi.sin(),
+            ..o
+        }
+    }
+
+    #[test]
+    fn no_obstacle_follows_the_paper_route_and_advances_every_waypoint() {
+        let route = Route::paper();
+        let mut rs = ReferenceSystem::new(route.clone(), GuidanceParams::default());
+        let mut tow = tow_at(route.points()[0], 0.0);
+        let mut visited = vec![1];
+        for _ in 0..1000 {
+            let out = rs.update(&tow, &[ObstacleInput::default(); 8]).unwrap();
+            assert!(!out.altered);
+            assert_eq!(out.theta, 0.0);
+            assert_eq!(out.d_ob, f64::INFINITY);
+            assert!(out.governing.is_none());
+            assert_eq!(out.eta_sd, route.points()[out.active_waypoint]);
+            assert_eq!(out.route_waypoint, out.eta_sd);
+            if *visited.last().unwrap() != out.active_waypoint {
+                visited.push(out.active_waypoint);
+            }
+            tow = step_towards(&tow, out.eta_sd, 0.1, 1.0);
+        }
+        // Every waypoint in order, none skipped, the destination held.
+        assert_eq!(visited, (1..=9).collect::<Vec<_>>());
+        assert_eq!(rs.active_waypoint(), 9);
+        assert!(dist(tow.ship.position(), [-43.0, 40.0]) < 1e-9);
+    }
+
+    #[test]
+    fn target_within_detection_ahead_alters_to_starboard() {
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let tow = tow_at(Pose::new(2.0, 0.0, 0.0), 0.1);
+        // Head-on target 6 m ahead of tug 2 (range-equivalent about 6.04 m < 7 m).
+        let target = vessel(2.0 + TUG2_AHEAD + 6.0, 0.2, PI, 0.07);
+        let out = rs.update(&tow, &[target]).unwrap();
+        assert!(out.altered);
+        let g = out.governing.unwrap();
+        assert_eq!(g.index, 0);
+        assert_eq!(g.nearest_vessel, TowVessel::Tug2);
+        assert_eq!(g.encounter.unwrap().situation, Situation::HeadOn);
+        assert_eq!(g.action, Action::AlterToStarboard);
+        assert!(g.range < 7.0 && g.range > 6.0);
+        assert_eq!(out.d_ob, g.range);
+        assert!((g.distance_eq9 - 2.0 * g.range).abs() < 1e-12);
+        assert!((g.safe_distance_eq14 - 2.0 * (0.97 + 0.74 + 0.25)).abs() < 1e-12);
+        // W_1 = (30, 0) rotated 15 deg clockwise about (0, 0): to the East.
+        assert!((out.theta - deg(15.0)).abs() < 1e-15);
+        assert!((out.eta_sd.x - 30.0 * deg(15.0).cos()).abs() < 1e-9);
+        assert!((out.eta_sd.y - 30.0 * deg(15.0).sin()).abs() < 1e-9);
+        assert!((out.eta_sd.psi - deg(15.0)).abs() < 1e-12);
+        assert_eq!(out.route_waypoint, Pose::new(30.0, 0.0, 0.0));
+
+        // The same target beyond d_D: not altered.
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let far = vessel(2.0 + TUG2_AHEAD + 7.2, 0.2, PI, 0.07);
+        let out = rs.update(&tow, &[far]).unwrap();
+        assert!(!out.altered);
+        assert_eq!(out.eta_sd, Pose::new(30.0, 0.0, 0.0));
+        assert_eq!(out.governing.unwrap().manoeuvre, Manoeuvre::FollowRoute);
+    }
+
+    #[test]
+    fn encounter_over_returns_to_the_unaltered_route_with_hysteresis() {
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let tow = tow_at(Pose::new(2.0, 0.0, 0.0), 0.1);
+        let tug2 = tow.tug2.x;
+        let at = |ahead: f64| [vessel(tug2 + ahead, 0.0, PI, 0.07)];
+        assert!(rs.update(&tow, &at(6.0)).unwrap().altered);
+        // The target now astern and opening (Safe), 7.3 m: inside d_D + 0.5 m,
+        // still altered (the encounter is not over).
+        let astern = |behind: f64| [vessel(tow.tug1.x - behind, 0.0, PI, 0.07)];
+        let out = rs.update(&tow, &astern(7.3)).unwrap();
+        let g = out.governing.unwrap();
+        assert_eq!(g.encounter.unwrap().situation, Situation::Safe);
+        // The encounter's situation is held.
+        assert_eq!(g.situation, Some(Situation::HeadOn));
+        assert!(out.altered);
+        assert!(out.eta_sd.y > 0.0);
+        // 7.6 m > 7.5 m: over, back to the predefined waypoint.
+        let out = rs.update(&tow, &astern(7.6)).unwrap();
+        assert!(!out.altered);
+        assert_eq!(out.theta, 0.0);
+        assert_eq!(out.eta_sd, Pose::new(30.0, 0.0, 0.0));
+        // A fresh target at 7.3 m (inside the margin but outside d_D) does not alter,
+        // and no situation is held for it.
+        let out = rs.update(&tow, &at(7.3)).unwrap();
+        assert!(!out.altered);
+        assert_eq!(out.governing.unwrap().situation, Some(Situation::HeadOn));
+        let out = rs.update(&tow, &astern(7.3)).unwrap();
+        assert_eq!(out.governing.unwrap().situation, Some(Situation::Safe));
+    }
+
+    #[test]
+    fn head_on_run_passes_port_to_port_and_returns_to_the_route() {
+        let route = north_route();
+        let mut rs = ReferenceSystem::new(route.clone(), GuidanceParams::default());
+        let mut tow = tow_at(route.points()[0], 0.0);
+        let mut target = vessel(40.0, 0.5, PI, 0.07);
+        let (mut was_altered, mut min_range, mut rel_at_min) = (false, f64::INFINITY, [0.0; 2]);
+        let mut released_at = None;
+        for t in 0..700 {
+            let out = rs.update(&tow, &[target]).unwrap();
+            if out.altered {
+                was_altered = true;
+                // Starboard of the northbound route, heading turned clockwise.
+                assert!(out.eta_sd.y > 0.0 && out.eta_sd.psi > 0.0);
+            } else if was_altered && released_at.is_none() {
+                released_at = Some(t);
+                assert_eq!(out.eta_sd, route.points()[out.active_waypoint]);
+            }
+            let rel = [target.x - tow.ship.x, target.y - tow.ship.y];
+            let r = rel[0].hypot(rel[1]);
+            if r < min_range {
+                min_range = r;
+                rel_at_min = rel;
+            }
+            tow = step_towards(&tow, out.eta_sd, 0.1, 1.0);
+            target = moved(target, 1.0);
+        }
+        assert!(was_altered && released_at.is_some());
+        // At the closest point the target (which started 0.5 m to starboard of the
+        // route) is on the ship's port side: a port-to-port pass (Rule 14).
+        assert!(rel_at_min[1] < 0.0, "{rel_at_min:?}");
+        assert!(min_range > 2.0, "{min_range}");
+        assert_eq!(rs.active_waypoint(), 2);
+        assert!(dist(tow.ship.position(), [60.0, 0.0]) < 1e-9);
+    }
+
+    /// Ship northbound at 0.1 m/s along the route, open loop; target from the port
+    /// side heading East at 4/60 m/s, on a collision course with the ship at
+    /// (6, 0) in 60 s.
+    #[test]
+    fn stand_on_crossing_from_port_waits_for_rule_17_then_alters_to_starboard() {
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let speed_t = 4.0 / 60.0;
+        let mut first_altered = None;
+        for t in 0..55 {
+            let t = f64::from(t);
+            let tow = tow_at(Pose::new(0.1 * t, 0.0, 0.0), 0.1);
+            let target = vessel(6.0, -4.0 + speed_t * t, deg(90.0), speed_t);
+            let out = rs.update(&tow, &[target]).unwrap();
+            let g = out.governing.unwrap();
+            let enc = g.encounter.unwrap();
+            assert_eq!(enc.situation, Situation::CrossingStandOn, "t = {t}");
+            assert_eq!(g.action, Action::StandOnThenAct);
+            // Detected from the start (tug 2 is 5.6 m away) ...
+            assert!(g.detected);
+            assert!((enc.cpa.tcpa - (60.0 - t)).abs() < 1e-9 && enc.cpa.dcpa < 1e-9);
+            if first_altered.is_none() {
+                // ... but the route is kept while TCPA > 30 s.
+                assert_eq!(out.altered, enc.cpa.tcpa <= 30.0, "t = {t}");
+                if out.altered {
+                    first_altered = Some(t);
+                }
+            } else {
+                // Once acted, the alteration holds (the target is still close).
+                assert!(out.altered);
+            }
+            if out.altered {
+                // To starboard of the northbound route, never to port.
+                assert!(out.eta_sd.y > 0.0 && out.eta_sd.psi > 0.0);
+            } else {
+                assert_eq!(out.eta_sd, Pose::new(30.0, 0.0, 0.0));
+            }
+        }
+        let first = first_altered.unwrap();
+        assert!((29.0..=31.0).contains(&first), "{first}");
+    }
+
+    #[test]
+    fn stand_on_keeps_the_route_when_the_give_way_vessel_passes_wide() {
+        // Same crossing, but the target crosses about 3.3 m ahead of the ship.
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let (mut saw_detected, mut saw_overtaking_geometry) = (false, false);
+        let speed_t = 4.0 / 60.0;
+        for t in 0..150 {
+            let t = f64::from(t);
+            let tow = tow_at(Pose::new(0.1 * t, 0.0, 0.0), 0.1);
+            let target = vessel(12.0, -4.0 + speed_t * t, deg(90.0), speed_t);
+            let out = rs.update(&tow, &[target]).unwrap();
+            assert!(!out.altered, "t = {t}: {out:?}");
+            let g = out.governing.unwrap();
+            if g.detected {
+                // Held from detection, while the geometry later reads
+                // "overtaking" once the target has crossed ahead.
+                assert_eq!(g.situation, Some(Situation::CrossingStandOn), "t = {t}");
+                saw_detected = true;
+            }
+            if g.encounter.unwrap().situation == Situation::Overtaking {
+                saw_overtaking_geometry = true;
+            }
+        }
+        assert!(saw_detected && saw_overtaking_geometry);
+    }
+
+    #[test]
+    fn port_side_targets_never_move_the_reference_to_port() {
+        // Targets on the port side at many bearings and headings, within d_D,
+        // close to collision course or not: the reference is the route or to its
+        // starboard side, for both presets and both tow statuses.
+        use crate::colregs::{ThresholdPreset, TowStatus};
+        for preset in [ThresholdPreset::Woerner, ThresholdPreset::Xu] {
+            for status in [
+                TowStatus::PowerDriven,
+                TowStatus::RestrictedInAbilityToManoeuvre,
+            ] {
+                let mut settings = GuidanceSettings::default();
+                settings.colregs.thresholds = preset.thresholds();
+                settings.colregs.tow_status = status;
+                let params = GuidanceParams::new(settings).unwrap();
+                let tow = tow_at(Pose::new(5.0, 0.0, 0.0), 0.1);
+                for beta in (-175..0).step_by(10) {
+                    for heading in (0..360).step_by(15) {
+                        let mut rs = ReferenceSystem::new(north_route(), params);
+                        let b = deg(f64::from(beta));
+                        let target = vessel(
+                            5.0 + 3.0 * b.cos(),
+                            3.0 * b.sin(),
+                            deg(f64::from(heading)),
+                            0.07,
+                        );
+                        let out = rs.update(&tow, &[target]).unwrap();
+                        assert!(out.eta_sd.y >= 0.0, "{beta} {heading}: {out:?}");
+                        assert!(out.eta_sd.psi >= 0.0);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn d_ob_is_the_minimum_over_the_three_vessels_and_kind_0_is_ignored() {
+        let tow = tow_at(Pose::new(0.0, 0.0, 0.0), 0.1);
+        let cases = [
+            // Beside the ship: ship nearest.
+            ([0.0, -2.0], TowVessel::Ship, 2.0),
+            // Astern: tug 1 nearest.
+            ([-TUG1_ASTERN - 1.5, 0.0], TowVessel::Tug1, 1.5),
+            // Ahead: tug 2 nearest.
+            ([TUG2_AHEAD + 2.2, 0.5], TowVessel::Tug2, 2.2f64.hypot(0.5)),
+        ];
+        let by_distance = GuidanceParams::new(GuidanceSettings {
+            static_hazard_policy: StaticHazardPolicy::ByDistance,
+            ..GuidanceSettings::default()
+        })
+        .unwrap();
+        for (pos, vessel_expected, d) in cases {
+            let mut rs = ReferenceSystem::new(north_route(), by_distance);
+            let empty = ObstacleInput {
+                x: f64::NAN,
+                kind: 0,
+                ..ObstacleInput::default()
+            };
+            let far = circle(-50.0, -50.0, 1.0);
+            let out = rs
+                .update(&tow, &[empty, far, circle(pos[0], pos[1], 1.0)])
+                .unwrap();
+            assert!((out.d_ob - d).abs() < 1e-12, "{out:?}");
+            let g = out.governing.unwrap();
+            assert_eq!(g.index, 2);
+            assert_eq!(g.nearest_vessel, vessel_expected);
+            assert!(g.encounter.is_none());
+            // Static hazard within 2.5 m: altered by distance (the paper's rule).
+            assert!(out.altered);
+            assert!(g.alteration_allowed);
+            let length = if vessel_expected == TowVessel::Ship {
+                1.255
+            } else {
+                0.97
+            };
+            assert!((g.safe_distance_eq14 - (length + 0.5 + 0.25)).abs() < 1e-12);
+        }
+        // Only a kind-0 slot sitting on the ship: nothing.
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let ghost = ObstacleInput {
+            kind: 0,
+            ..circle(0.0, 0.0, 1.0)
+        };
+        let out = rs.update(&tow, &[ghost]).unwrap();
+        assert_eq!(out.d_ob, f64::INFINITY);
+        assert!(!out.altered && out.governing.is_none());
+    }
+
+    #[test]
+    fn static_hazard_alters_only_where_altering_helps() {
+        // Ship at (5, 0) on the northbound leg (0,0) -> (30,0); W_1N = (28.98, 7.76).
+        let tow = tow_at(Pose::new(5.0, 0.0, 0.0), 0.1);
+        let check = |params: GuidanceParams, pos: [f64; 2]| {
+            let mut rs = ReferenceSystem::new(north_route(), params);
+            let out = rs.update(&tow, &[circle(pos[0], pos[1], 1.0)]).unwrap();
+            let g = out.governing.unwrap();
+            assert!(g.detected, "{pos:?}");
+            (out.altered, g.alteration_allowed)
+        };
+        let helps = GuidanceParams::default();
+        let by_distance = GuidanceParams::new(GuidanceSettings {
+            static_hazard_policy: StaticHazardPolicy::ByDistance,
+            ..GuidanceSettings::default()
+        })
+        .unwrap();
+        // Ahead on the route line and to port: the altered leg passes it farther.
+        assert_eq!(check(helps, [9.0, 0.0]), (true, true));
+        assert_eq!(check(helps, [6.0, -2.0]), (true, true));
+        // To starboard: the altered leg would approach it; the route is kept.
+        assert_eq!(check(helps, [6.0, 2.0]), (false, false));
+        // Astern of W_{p-1}: both legs pass it alike; no alteration.
+        let mut rs = ReferenceSystem::new(north_route(), helps);
+        let near_start = tow_at(Pose::new(0.5, 0.0, 0.0), 0.1);
+        assert!(
+            !rs.update(&near_start, &[circle(-1.0, 0.0, 1.0)])
+                .unwrap()
+                .altered
+        );
+        // The paper's literal rule alters for all of them.
+        assert_eq!(check(by_distance, [6.0, 2.0]), (true, true));
+        assert_eq!(check(by_distance, [9.0, 0.0]), (true, true));
+    }
+
+    #[test]
+    fn static_hazard_releases_when_a_new_leg_makes_altering_useless() {
+        // Route (0,0) -> (10,0) -> (10,10). A hazard at (9, -1) lies to port of
+        // leg 1 (altering helps) and behind the start of leg 2 (both legs of leg 2
+        // pass it alike: altering does not help).
+        let route = Route::from_positions(&[[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]]).unwrap();
+        let mut rs = ReferenceSystem::new(route, GuidanceParams::default());
+        let hazard = [circle(9.0, -1.0, 1.0)];
+        let out = rs
+            .update(&tow_at(Pose::new(8.0, 0.0, 0.0), 0.1), &hazard)
+            .unwrap();
+        assert!(out.altered && out.active_waypoint == 1);
+        // At W_1N = (9.66, 2.59), heading East: the waypoint is reached, leg 2 is
+        // active; tug 1 is 1.56 m from the hazard.
+        let at_w1n = tow_at(Pose::new(9.66, 2.59, deg(90.0)), 0.1);
+        let out = rs.update(&at_w1n, &hazard).unwrap();
+        assert_eq!(out.active_waypoint, 2);
+        // Next sample: the hazard no longer holds the alteration, although it is
+        // within its distance.
+        let out = rs.update(&at_w1n, &hazard).unwrap();
+        assert!(!out.altered, "{out:?}");
+        let g = out.governing.unwrap();
+        assert!(g.detected && !g.alteration_allowed && out.d_ob < 2.5);
+    }
+
+    #[test]
+    fn static_hazard_beyond_its_distance_does_not_alter() {
+        // The paper's hazard c passes 2.98 m from the route: no alteration at 2.9 m.
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let tow = tow_at(Pose::new(5.0, 0.0, 0.0), 0.1);
+        let out = rs.update(&tow, &[circle(5.0, -2.9, 1.0)]).unwrap();
+        assert!(!out.altered);
+        assert!((out.d_ob - 2.9).abs() < 1e-12);
+        assert!(rs.update(&tow, &[circle(5.0, -2.4, 1.0)]).unwrap().altered);
+    }
+
+    #[test]
+    fn theta_is_clamped_to_theta_max() {
+        let settings = GuidanceSettings {
+            waterway_half_width: Some(1.0),
+            ..GuidanceSettings::default()
+        };
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::new(settings).unwrap());
+        let tow = tow_at(Pose::new(2.0, 0.0, 0.0), 0.1);
+        let out = rs.update(&tow, &[circle(2.0, -2.0, 1.0)]).unwrap();
+        assert!(out.altered);
+        let bound = (1.0f64 / 30.0).atan();
+        assert!((out.theta - bound).abs() < 1e-15);
+        assert!((out.eta_sd.psi - bound).abs() < 1e-15);
+        assert!(out.eta_sd.y > 0.0 && out.eta_sd.y < 1.0);
+    }
+
+    #[test]
+    fn passing_beside_a_waypoint_advances() {
+        let route = north_route();
+        let mut rs = ReferenceSystem::new(route.clone(), GuidanceParams::default());
+        // 1 m beside W_1, just past its normal line.
+        let out = rs
+            .update(&tow_at(Pose::new(30.01, 1.0, 0.0), 0.1), &[])
+            .unwrap();
+        assert_eq!(out.active_waypoint, 2);
+        // Without the passing rule, it does not.
+        let settings = GuidanceSettings {
+            advance_on_passing: false,
+            ..GuidanceSettings::default()
+        };
+        let mut rs = ReferenceSystem::new(route, GuidanceParams::new(settings).unwrap());
+        let out = rs
+            .update(&tow_at(Pose::new(30.01, 1.0, 0.0), 0.1), &[])
+            .unwrap();
+        assert_eq!(out.active_waypoint, 1);
+        // Within the acceptance radius it does.
+        let out = rs
+            .update(&tow_at(Pose::new(29.6, 0.3, 0.0), 0.1), &[])
+            .unwrap();
+        assert_eq!(out.active_waypoint, 2);
+        // The destination is held, even far past it.
+        let out = rs
+            .update(&tow_at(Pose::new(80.0, 0.0, 0.0), 0.1), &[])
+            .unwrap();
+        assert_eq!(out.active_waypoint, 2);
+        assert_eq!(out.eta_sd, Pose::new(60.0, 0.0, 0.0));
+    }
+
+    #[test]
+    fn bad_inputs_are_refused_and_leave_the_state_unchanged() {
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let tow = tow_at(Pose::new(2.0, 0.0, 0.0), 0.1);
+        assert!(rs.update(&tow, &[circle(2.0, -2.0, 1.0)]).unwrap().altered);
+        let bad = ObstacleInput {
+            kind: 7,
+            ..ObstacleInput::default()
+        };
+        assert_eq!(
+            rs.update(&tow, &[bad]),
+            Err(InputError::UnknownKind { code: 7 })
+        );
+        assert!(rs.is_altered());
+        let mut nan_tow = tow;
+        nan_tow.tug2.y = f64::NAN;
+        assert!(matches!(
+            rs.update(&nan_tow, &[]),
+            Err(InputError::NonFiniteTowState { field: "tug2.y" })
+        ));
+        let many = [ObstacleInput::default(); MAX_OBSTACLES + 1];
+        assert!(matches!(
+            rs.update(&tow, &many),
+            Err(InputError::TooManyObstacles { .. })
+        ));
+        assert!(rs.is_altered() && rs.active_waypoint() == 1);
+        rs.reset();
+        assert!(!rs.is_altered());
+    }
+
+    #[test]
+    fn same_inputs_give_bit_identical_outputs() {
+        let run = || {
+            let mut rs = ReferenceSystem::new(Route::paper(), GuidanceParams::default());
+            let mut tow = tow_at(Route::paper().points()[0], 0.0);
+            let mut target = vessel(-19.0, 21.0, 0.0, 0.07);
+            let mut outs = Vec::new();
+            for _ in 0..400 {
+                let out = rs
+                    .update(&tow, &[target, circle(-10.0, 15.0, 1.0)])
+                    .unwrap();
+                outs.push(out);
+                tow = step_towards(&tow, out.eta_sd, 0.1, 1.0);
+                target = moved(target, 1.0);
+            }
+            outs
+        };
+        let (a, b) = (run(), run());
+        assert_eq!(a, b);
+        // The paper's first encounter (target A crossing from starboard) alters the
+        // route at some point.
+        assert!(a.iter().any(|o| o.altered
+            && o.governing.is_some_and(|g| g
+                .encounter
+                .is_some_and(|e| e.situation == Situation::CrossingGiveWay))));
+    }
+}
