@@ -1,8 +1,10 @@
 //! Prediction models of the distributed MPC of Du, Negenborn, Reppa (2022),
 //! "COLREGS-compliant collision avoidance for physically coupled multi-vessel
 //! systems with distributed MPC", Ocean Engineering 260, 111917 (CC BY 4.0),
-//! sections 3.2-3.3, and their exact linearisations for sequential convex
-//! programming. The optimisation, ADMM and the FMU are elsewhere.
+//! sections 3.2-3.3, their exact linearisations for sequential convex
+//! programming, and one SCP step of each subproblem of the ADMM: the tug local
+//! problem (25) ([`TugMpc`]) and the coordination problem (26) ([`ShipMpc`]), on
+//! a thin Clarabel wrapper ([`Qp`]). The ADMM loop and the FMU are elsewhere.
 //!
 //! - [`ShipModel`]: the coordination controller's model, eq. (15) in the
 //!   consistent form of `paper/NOTES.md` (state `[x, y, psi, u, v, r]`, input
@@ -15,6 +17,11 @@
 //!   (analytic for the built-in hulls, finite differences for user hulls; why in
 //!   [`hull`]).
 //! - [`PredictionParams`]: sample time and RK4 substep (zero-order hold).
+//! - [`TugMpc`], [`ShipMpc`]: one SCP step of the ADMM subproblems (25) and (26)
+//!   (condensed QP in the input increments, trust region, accept/reject on the
+//!   true cost; shared machinery in [`scp`]), [`Obstacle`] and the distance cost
+//!   [`DistanceCost`] (`phi`, made honest), [`Qp`]: the Clarabel wrapper with a
+//!   fixed structure updated in place ([`QpOutcome`] as a value).
 //!
 //! Physics honesty (DESIGN.md): the models use the plant's own code for
 //! everything the plant computes: the hull ([`towing_model::HullModel::build`] and
@@ -77,17 +84,27 @@
 pub mod formation;
 pub mod hull;
 pub mod lines;
+pub mod obstacle;
 pub mod params;
+pub mod qp;
 mod rk4;
+pub mod scp;
 pub mod ship;
+pub mod ship_mpc;
 pub mod tug;
+pub mod tug_mpc;
 
 pub use formation::FormationMap;
 pub use hull::{JacobianMethod, PredictionHull};
 pub use lines::line_direction;
+pub use obstacle::{DistanceCost, Obstacle};
 pub use params::PredictionParams;
+pub use qp::{Qp, QpFailure, QpOutcome};
+pub use scp::{ClearanceParams, ScpReport, ScpSettings, TrustRegion};
 pub use ship::{ShipInput, ShipLinearisation, ShipModel, ShipState};
+pub use ship_mpc::{ShipMpc, ShipMpcParams, ShipStepData};
 pub use tug::{TowlinePull, TugInput, TugLinearisation, TugModel, TugState};
+pub use tug_mpc::{TugMpc, TugMpcParams, TugStepData, HORIZON};
 
 #[cfg(test)]
 mod tests;
