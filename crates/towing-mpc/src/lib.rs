@@ -4,7 +4,8 @@
 //! sections 3.2-3.3, their exact linearisations for sequential convex
 //! programming, and one SCP step of each subproblem of the ADMM: the tug local
 //! problem (25) ([`TugMpc`]) and the coordination problem (26) ([`ShipMpc`]), on
-//! a thin Clarabel wrapper ([`Qp`]). The ADMM loop and the FMU are elsewhere.
+//! a thin Clarabel wrapper ([`Qp`]), and the ADMM loop of Algorithm 1 over them
+//! ([`Admm`], one control sample). The FMU is elsewhere.
 //!
 //! - [`ShipModel`]: the coordination controller's model, eq. (15) in the
 //!   consistent form of `paper/NOTES.md` (state `[x, y, psi, u, v, r]`, input
@@ -81,6 +82,7 @@
 // Tests may unwrap: a panic is the failure report.
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
+pub mod admm;
 pub mod formation;
 pub mod hull;
 pub mod lines;
@@ -94,6 +96,9 @@ pub mod ship_mpc;
 pub mod tug;
 pub mod tug_mpc;
 
+pub use admm::{
+    Admm, AdmmBuildError, AdmmReport, AdmmSettings, AppliedCommand, IterationRecord, SampleInput,
+};
 pub use formation::FormationMap;
 pub use hull::{JacobianMethod, PredictionHull};
 pub use lines::line_direction;

@@ -208,6 +208,18 @@ impl ShipMpc {
         &self.states
     }
 
+    /// The prediction model.
+    #[must_use]
+    pub fn model(&self) -> &ShipModel {
+        &self.model
+    }
+
+    /// The configuration map.
+    #[must_use]
+    pub fn formation(&self) -> &FormationMap {
+        &self.formation
+    }
+
     /// The parameters.
     #[must_use]
     pub fn params(&self) -> &ShipMpcParams {

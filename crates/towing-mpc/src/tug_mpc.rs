@@ -169,6 +169,12 @@ impl TugMpc {
         &mut self.trust
     }
 
+    /// The prediction model.
+    #[must_use]
+    pub fn model(&self) -> &TugModel {
+        &self.model
+    }
+
     /// The parameters.
     #[must_use]
     pub fn params(&self) -> &TugMpcParams {

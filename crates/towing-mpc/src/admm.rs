@@ -1,0 +1,517 @@
+//! The ADMM loop of Du, Negenborn, Reppa (2022), Algorithm 1 with eq. (22)-(29),
+//! for one control sample (`docs/controller-design.md`, "ADMM").
+//!
+//! Per iteration `s = 1..S`:
+//!
+//! 1. each tug takes one SCP step of (25) ([`TugMpc::solve_step`]) given
+//!    `f_i(tau_S^{s-1})`: the tug references of the configuration map
+//!    ([`FormationMap`]) along the ship's current predicted trajectory and towing
+//!    angles, the towline pulls of the ship's current plan (tension `F_ih`, bearing
+//!    `psi_S + alpha_ih` with `psi_S` the ship's heading at the start of sample `h`,
+//!    [`TowlinePull::from_plan`]) and `lambda^{s-1}`;
+//! 2. the ship takes one SCP step of (26) ([`ShipMpc::solve_step`]) given
+//!    `g_i(tau_Ti^s)`, the tugs' predicted poses, and `lambda^{s-1}`;
+//! 3. `lambda_i += rho (g_i - f_i)` (27), with `f_i = f_i(tau_S^s)`;
+//! 4. residuals `r_pri,i = |g_i - f_i|_2`, `r_dual,i = |f_i^s - f_i^{s-1}|_2` and
+//!    the tolerances of (29) with `n_s = 3 H`; stop when both hold for both tugs,
+//!    or after `max_iterations`.
+//!
+//! The dual residual is taken as printed in eq. (28), without the factor `rho`
+//! of the standard ADMM dual residual `rho (f^s - f^{s-1})` (Boyd et al. 2010,
+//! eq. (3.12)); with `rho` of order 1 the two differ little, and the printed form
+//! keeps the stopping rule meaningful for `rho = 0`.
+//!
+//! Headings: the plant wraps headings to `(-pi, pi]`, the prediction models keep
+//! them continuous. On entry each tug's heading is unwrapped to within `pi` of the
+//! ship's (`psi_S + angle_difference(psi_i, psi_S)`), so `g_i` and `f_i`
+//! (`psi_S + alpha_i`) are continuous and close; every heading difference (the
+//! residuals, the multiplier update) is additionally wrapped with
+//! [`angle_difference`], the subproblems' own rule.
+//!
+//! Warm start: [`Admm::shift`] moves every plan and multiplier one sample ahead
+//! (the last sample repeated) for the next control sample. Without a shift since
+//! the construction (or [`Admm::reset`]) the sample starts cold: the plans repeat
+//! the previously applied command, the multipliers are zero.
+//!
+//! Allocation: none per sample; the subproblems, multipliers, residual history
+//! (fixed capacity [`MAX_ITERATIONS`]) are made at construction.
+
+// Index loops over (tug, sample, component) triples address several arrays.
+#![allow(clippy::needless_range_loop)]
+
+use std::fmt;
+
+use towing_model::{HullModel, ParamError, Scenario};
+
+use crate::formation::FormationMap;
+use crate::obstacle::Obstacle;
+use crate::params::PredictionParams;
+use crate::qp::QpBuildError;
+use crate::scp::{angle_difference, ScpReport};
+use crate::ship::{ShipInput, ShipModel, ShipState};
+use crate::ship_mpc::{ShipMpc, ShipMpcParams, ShipStepData};
+use crate::tug::{TowlinePull, TugInput, TugModel, TugState};
+use crate::tug_mpc::{TugMpc, TugMpcParams, TugStepData, HORIZON};
+
+/// Capacity of the residual history, and the largest `max_iterations` accepted.
+pub const MAX_ITERATIONS: usize = 100;
+
+/// `n_s` of eq. (29): the size of a tug's coupling variable, `3 H`.
+const N_S: usize = 3 * HORIZON;
+
+/// Parameters of the ADMM loop.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AdmmSettings {
+    /// Penalty `rho` of eq. (22) (>= 0, finite).
+    pub rho: f64,
+    /// `S`: most iterations per sample (1..=[`MAX_ITERATIONS`]).
+    pub max_iterations: usize,
+    /// `eps_abs` of eq. (29) (> 0).
+    pub eps_abs: f64,
+    /// `eps_rel` of eq. (29) (>= 0).
+    pub eps_rel: f64,
+}
+
+impl Default for AdmmSettings {
+    /// `eps_abs = eps_rel = 1e-3` (Table 3). `rho` and `S` are not given in the
+    /// paper; `rho = 20`, `S = 30` were chosen by measurement on the tests'
+    /// instances (see the `rho_sweep` test in this module, run with
+    /// `--ignored --nocapture`).
+    fn default() -> Self {
+        AdmmSettings {
+            rho: 20.0,
+            max_iterations: 30,
+            eps_abs: 1e-3,
+            eps_rel: 1e-3,
+        }
+    }
+}
+
+impl AdmmSettings {
+    /// Checks the values (see the fields).
+    pub fn validate(&self) -> Result<(), ParamError> {
+        let bad = |field: &str, reason: String| ParamError {
+            field: field.to_owned(),
+            reason,
+        };
+        if !(self.rho.is_finite() && self.rho >= 0.0) {
+            return Err(bad(
+                "rho",
+                format!("must be finite and >= 0, got {}", self.rho),
+            ));
+        }
+        if self.max_iterations == 0 || self.max_iterations > MAX_ITERATIONS {
+            return Err(bad(
+                "max_iterations",
+                format!(
+                    "must be in 1..={MAX_ITERATIONS}, got {}",
+                    self.max_iterations
+                ),
+            ));
+        }
+        if !(self.eps_abs.is_finite() && self.eps_abs > 0.0) {
+            return Err(bad(
+                "eps_abs",
+                format!("must be finite and > 0, got {}", self.eps_abs),
+            ));
+        }
+        if !(self.eps_rel.is_finite() && self.eps_rel >= 0.0) {
+            return Err(bad(
+                "eps_rel",
+                format!("must be finite and >= 0, got {}", self.eps_rel),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Why an [`Admm`] could not be built.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AdmmBuildError {
+    /// Bad settings or model parameters.
+    Param(ParamError),
+    /// A subproblem's QP could not be built.
+    Qp(QpBuildError),
+}
+
+impl fmt::Display for AdmmBuildError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            AdmmBuildError::Param(e) => write!(f, "{}: {}", e.field, e.reason),
+            AdmmBuildError::Qp(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for AdmmBuildError {}
+
+impl From<ParamError> for AdmmBuildError {
+    fn from(e: ParamError) -> Self {
+        AdmmBuildError::Param(e)
+    }
+}
+
+impl From<QpBuildError> for AdmmBuildError {
+    fn from(e: QpBuildError) -> Self {
+        AdmmBuildError::Qp(e)
+    }
+}
+
+/// The command applied in the previous sample.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct AppliedCommand {
+    /// `[F_1, F_2, alpha_1, alpha_2]`: the rate bounds (20)-(21) of the first sample.
+    pub ship: ShipInput,
+    /// `tau_T1, tau_T2`: the tugs have no rate bound (eq. (19) only); used as the
+    /// cold-start plan.
+    pub tugs: [TugInput; 2],
+}
+
+/// The data of one control sample.
+#[derive(Debug, Clone, Copy)]
+pub struct SampleInput<'a> {
+    /// The ship's current state (heading as the plant gives it).
+    pub ship: ShipState,
+    /// The tugs' current states (0 = tug 1 aft, 1 = tug 2 forward).
+    pub tugs: [TugState; 2],
+    /// The command applied in the previous sample.
+    pub previous: AppliedCommand,
+    /// `eta_Sd` per sample (for the state after sample `h`), from guidance.
+    pub reference: [[f64; 3]; HORIZON],
+    /// Static obstacles.
+    pub obstacles: &'a [Obstacle],
+}
+
+/// Residuals and tolerances of one iteration (per tug).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct IterationRecord {
+    /// `|g_i - f_i|_2`.
+    pub r_pri: [f64; 2],
+    /// `|f_i^s - f_i^{s-1}|_2` (eq. (28) as printed, module docs).
+    pub r_dual: [f64; 2],
+    /// `eps_pri,i` of eq. (29).
+    pub eps_pri: [f64; 2],
+    /// `eps_dual,i` of eq. (29).
+    pub eps_dual: [f64; 2],
+}
+
+impl IterationRecord {
+    /// Whether (28) holds for both tugs.
+    #[must_use]
+    pub fn satisfied(&self) -> bool {
+        (0..2).all(|i| self.r_pri[i] <= self.eps_pri[i] && self.r_dual[i] <= self.eps_dual[i])
+    }
+}
+
+/// What one sample's loop did.
+#[derive(Debug, Clone, Copy)]
+pub struct AdmmReport {
+    /// Iterations run (1..=`max_iterations`).
+    pub iterations: usize,
+    /// Whether the stopping rule (28)-(29) ended the loop.
+    pub converged: bool,
+    /// Final primal residuals.
+    pub r_pri: [f64; 2],
+    /// Final dual residuals.
+    pub r_dual: [f64; 2],
+    /// Final primal tolerances.
+    pub eps_pri: [f64; 2],
+    /// Final dual tolerances.
+    pub eps_dual: [f64; 2],
+    /// Per iteration (the first `iterations` entries are set).
+    pub history: [IterationRecord; MAX_ITERATIONS],
+    /// The last SCP step of tug 1, tug 2 and the ship.
+    pub last_steps: [ScpReport; 3],
+    /// Subproblem steps over the loop whose QP gave no usable solution (the
+    /// plan was kept).
+    pub failed_steps: usize,
+    /// First move: tensions `F_1, F_2` (N).
+    pub tension: [f64; 2],
+    /// First move: towing angles `alpha_1, alpha_2` (rad).
+    pub angle: [f64; 2],
+    /// First move: thrust of tug 1 and tug 2.
+    pub tug_thrust: [TugInput; 2],
+}
+
+impl AdmmReport {
+    /// The records of the iterations run.
+    #[must_use]
+    pub fn history(&self) -> &[IterationRecord] {
+        &self.history[..self.iterations]
+    }
+
+    /// Whether the last step of any subproblem had no usable QP solution.
+    #[must_use]
+    pub fn last_step_failed(&self) -> bool {
+        self.last_steps.iter().any(|r| !r.qp.is_usable())
+    }
+}
+
+/// The distributed MPC for one control sample (module docs).
+#[derive(Debug)]
+pub struct Admm {
+    settings: AdmmSettings,
+    ship: ShipMpc,
+    tugs: [TugMpc; 2],
+    formation: FormationMap,
+    lambda: [[[f64; 3]; HORIZON]; 2],
+    f_prev: [[[f64; 3]; HORIZON]; 2],
+    warm: bool,
+}
+
+impl Admm {
+    /// The loop over the given subproblems (`tugs[i]` must model the tug on line
+    /// `i`); the map is taken from the ship problem.
+    pub fn new(
+        ship: ShipMpc,
+        tugs: [TugMpc; 2],
+        settings: AdmmSettings,
+    ) -> Result<Admm, ParamError> {
+        settings.validate()?;
+        for (i, tug) in tugs.iter().enumerate() {
+            if tug.model().line() != i {
+                return Err(ParamError {
+                    field: format!("tugs[{i}]"),
+                    reason: format!("models the tug on line {}", tug.model().line()),
+                });
+            }
+        }
+        let formation = *ship.formation();
+        Ok(Admm {
+            settings,
+            ship,
+            tugs,
+            formation,
+            lambda: [[[0.0; 3]; HORIZON]; 2],
+            f_prev: [[[0.0; 3]; HORIZON]; 2],
+            warm: false,
+        })
+    }
+
+    /// The loop for a scenario's vessels with the default subproblem parameters.
+    pub fn from_scenario(
+        scenario: &Scenario,
+        hull: HullModel,
+        params: PredictionParams,
+        settings: AdmmSettings,
+    ) -> Result<Admm, AdmmBuildError> {
+        let ship = ShipMpc::new(
+            ShipModel::from_scenario(scenario, hull, params)?,
+            FormationMap::from_scenario(scenario)?,
+            ShipMpcParams::default(),
+        )?;
+        let tug = |i| -> Result<TugMpc, AdmmBuildError> {
+            Ok(TugMpc::new(
+                TugModel::from_scenario(scenario, i, hull, params)?,
+                TugMpcParams::default(),
+            )?)
+        };
+        Ok(Admm::new(ship, [tug(0)?, tug(1)?], settings)?)
+    }
+
+    /// The settings.
+    #[must_use]
+    pub fn settings(&self) -> &AdmmSettings {
+        &self.settings
+    }
+
+    /// The coordination problem (plan, predicted states).
+    #[must_use]
+    pub fn ship(&self) -> &ShipMpc {
+        &self.ship
+    }
+
+    /// Tug `i`'s local problem.
+    ///
+    /// # Panics
+    /// If `i > 1`.
+    #[must_use]
+    pub fn tug(&self, i: usize) -> &TugMpc {
+        &self.tugs[i]
+    }
+
+    /// The multipliers `lambda_i` (per sample, `[x, y, psi]`).
+    #[must_use]
+    pub fn lambda(&self) -> &[[[f64; 3]; HORIZON]; 2] {
+        &self.lambda
+    }
+
+    /// Next sample starts cold (module docs); trust regions back to their start.
+    pub fn reset(&mut self) {
+        self.lambda = [[[0.0; 3]; HORIZON]; 2];
+        self.warm = false;
+        self.ship.trust_region_mut().reset();
+        for tug in &mut self.tugs {
+            tug.trust_region_mut().reset();
+        }
+    }
+
+    /// Warm start for the next sample: plans and multipliers one sample ahead,
+    /// the last sample repeated.
+    pub fn shift(&mut self) {
+        fn shifted<T: Copy>(a: &[T; HORIZON]) -> [T; HORIZON] {
+            std::array::from_fn(|h| a[(h + 1).min(HORIZON - 1)])
+        }
+        self.ship.set_plan(shifted(self.ship.plan()));
+        for tug in &mut self.tugs {
+            let plan = shifted(tug.plan());
+            tug.set_plan(plan);
+        }
+        for i in 0..2 {
+            self.lambda[i] = shifted(&self.lambda[i]);
+            self.f_prev[i] = shifted(&self.f_prev[i]);
+        }
+        self.warm = true;
+    }
+
+    /// Algorithm 1 for one sample (module docs). Failed subproblem solves are
+    /// counted in the report; the loop goes on with the kept plan.
+    pub fn solve_sample(&mut self, input: &SampleInput<'_>) -> AdmmReport {
+        let s = self.settings;
+        if !self.warm {
+            self.ship.set_plan([input.previous.ship; HORIZON]);
+            for (tug, tau) in self.tugs.iter_mut().zip(input.previous.tugs) {
+                tug.set_plan([tau; HORIZON]);
+            }
+            self.lambda = [[[0.0; 3]; HORIZON]; 2];
+        }
+        // Tug headings unwrapped next to the ship's.
+        let mut tug_states = input.tugs;
+        for x in &mut tug_states {
+            x[2] = input.ship[2] + angle_difference(x[2], input.ship[2]);
+        }
+        // f^0: the references along the current ship plan.
+        let mut ship_states = self
+            .ship
+            .model()
+            .rollout::<HORIZON>(&input.ship, self.ship.plan());
+        let mut ship_plan = *self.ship.plan();
+        let mut f = [[[0.0; 3]; HORIZON]; 2];
+        for i in 0..2 {
+            self.formation
+                .tug_references_into(i, &ship_states, &ship_plan, &mut f[i]);
+        }
+        self.f_prev = f;
+
+        let mut history = [IterationRecord::default(); MAX_ITERATIONS];
+        let mut last_steps = [None; 3];
+        let mut failed_steps = 0;
+        let mut iterations = 0;
+        let mut converged = false;
+        while iterations < s.max_iterations {
+            // (1) tug steps given f^{s-1}, the pulls of the ship plan, lambda^{s-1}.
+            let mut g = [[[0.0; 3]; HORIZON]; 2];
+            for i in 0..2 {
+                let pulls = std::array::from_fn(|h| {
+                    let psi = if h == 0 {
+                        input.ship[2]
+                    } else {
+                        ship_states[h - 1][2]
+                    };
+                    TowlinePull::from_plan(ship_plan[h][i], psi, ship_plan[h][2 + i])
+                });
+                let data = TugStepData {
+                    state: tug_states[i],
+                    pulls,
+                    reference: f[i],
+                    lambda: self.lambda[i],
+                    rho: s.rho,
+                    obstacles: input.obstacles,
+                };
+                let report = self.tugs[i].solve_step(&data);
+                failed_steps += usize::from(!report.qp.is_usable());
+                last_steps[i] = Some(report);
+                for (gh, x) in g[i].iter_mut().zip(self.tugs[i].predicted_states()) {
+                    *gh = [x[0], x[1], x[2]];
+                }
+            }
+            // (2) ship step given g^s and lambda^{s-1}.
+            let data = ShipStepData {
+                state: input.ship,
+                previous: input.previous.ship,
+                reference: input.reference,
+                tug_poses: g,
+                lambda: self.lambda,
+                rho: s.rho,
+                obstacles: input.obstacles,
+            };
+            let report = self.ship.solve_step(&data);
+            failed_steps += usize::from(!report.qp.is_usable());
+            last_steps[2] = Some(report);
+            ship_states = *self.ship.predicted_states();
+            ship_plan = *self.ship.plan();
+            for i in 0..2 {
+                self.formation
+                    .tug_references_into(i, &ship_states, &ship_plan, &mut f[i]);
+            }
+            // (3) multipliers, (4) residuals and tolerances.
+            let mut record = IterationRecord::default();
+            for i in 0..2 {
+                let (mut pri, mut dual, mut gn, mut fn_, mut ln) = (0.0, 0.0, 0.0, 0.0, 0.0);
+                for h in 0..HORIZON {
+                    let r = difference(&g[i][h], &f[i][h]);
+                    let d = difference(&f[i][h], &self.f_prev[i][h]);
+                    for c in 0..3 {
+                        self.lambda[i][h][c] += s.rho * r[c];
+                        pri += r[c] * r[c];
+                        dual += d[c] * d[c];
+                        gn += g[i][h][c] * g[i][h][c];
+                        fn_ += f[i][h][c] * f[i][h][c];
+                        ln += self.lambda[i][h][c] * self.lambda[i][h][c];
+                    }
+                }
+                let base = (N_S as f64).sqrt() * s.eps_abs;
+                record.r_pri[i] = pri.sqrt();
+                record.r_dual[i] = dual.sqrt();
+                record.eps_pri[i] = base + s.eps_rel * gn.sqrt().max(fn_.sqrt());
+                record.eps_dual[i] = base + s.eps_rel * ln.sqrt();
+            }
+            self.f_prev = f;
+            history[iterations] = record;
+            iterations += 1;
+            if record.satisfied() {
+                converged = true;
+                break;
+            }
+        }
+        let last = history[iterations - 1];
+        let first = self.ship.plan()[0];
+        AdmmReport {
+            iterations,
+            converged,
+            r_pri: last.r_pri,
+            r_dual: last.r_dual,
+            eps_pri: last.eps_pri,
+            eps_dual: last.eps_dual,
+            history,
+            last_steps: last_steps.map(|r| r.unwrap_or_else(never_run)),
+            failed_steps,
+            tension: [first[0], first[1]],
+            angle: [first[2], first[3]],
+            tug_thrust: [self.tugs[0].plan()[0], self.tugs[1].plan()[0]],
+        }
+    }
+}
+
+/// `a - b`, the heading wrapped.
+fn difference(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], angle_difference(a[2], b[2])]
+}
+
+/// Placeholder for a subproblem that did not run (not reached: at least one
+/// iteration always runs).
+fn never_run() -> ScpReport {
+    ScpReport {
+        qp: crate::QpOutcome::Failed(crate::QpFailure::Other),
+        accepted: false,
+        cost_before: f64::NAN,
+        cost_after: f64::NAN,
+        predicted_decrease: 0.0,
+        ratio: f64::NAN,
+        radius: 0.0,
+        qp_iterations: 0,
+    }
+}
+
+#[cfg(test)]
+mod tests;
