@@ -18,6 +18,7 @@
 //! `ratio >= good`, shrinks (x `shrink`, down to `min_radius`) when `ratio < poor`
 //! or the QP gave no usable solution.
 
+use crate::obstacle::{DistanceCost, Obstacle};
 use crate::qp::{upper_index, Pattern, Qp, QpBuildError, QpOutcome};
 
 /// Trust-region parameters of the SCP step (dimensionless: the radius multiplies
@@ -403,6 +404,60 @@ impl Clearance {
         self.grad[k * self.n_u..(k + 1) * self.n_u].copy_from_slice(&row[..self.n_u]);
     }
 
+    /// Forgets the rows implied by the increments' boxes `[lo_v, hi_v]`: a row
+    /// with `min over the box of (dd/du) du >= d_min - d` holds at `s = 0` for every
+    /// increment in the box, so its slack (of positive cost, in no other row) is
+    /// zero at the optimum and the row never binds: without it the QP has the same
+    /// solution (and the penalty `W max(0, d_min - d)` is zero, as is the row's
+    /// predicted decrease).
+    pub fn drop_redundant(&mut self, lo: &[f64], hi: &[f64]) {
+        let n_u = self.n_u;
+        for k in 0..self.active.len() {
+            if !self.active[k] {
+                continue;
+            }
+            let grad = &self.grad[k * n_u..(k + 1) * n_u];
+            let worst: f64 = grad
+                .iter()
+                .zip(lo.iter().zip(hi))
+                .map(|(g, (l, h))| (g * l).min(g * h))
+                .sum();
+            if worst >= self.params.min_distance - self.dist[k] + 1e-9 {
+                self.active[k] = false;
+            }
+        }
+    }
+
+    /// Obstacle slots per sample in use: one more than the highest obstacle index
+    /// recorded at any sample (0 if none).
+    pub fn slots_used(&self) -> usize {
+        let m = self.params.max_obstacles;
+        (0..self.active.len())
+            .filter(|&k| self.active[k])
+            .map(|k| k % m + 1)
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Takes over the linearisation recorded in `full` (same increments and
+    /// horizon, at least as many slots per sample) for this layout's slots. An
+    /// unused slot (no row recorded) is a row `-s <= 0` on a slack of positive
+    /// cost: its slack is zero at the optimum, so a layout without the unused
+    /// slots has the same solution in the increments (and fewer rows).
+    pub fn copy_from(&mut self, full: &Clearance) {
+        let (m, mf, n_u) = (
+            self.params.max_obstacles,
+            full.params.max_obstacles,
+            self.n_u,
+        );
+        for k in 0..self.active.len() {
+            let kf = (k / m) * mf + k % m;
+            self.active[k] = full.active[kf];
+            self.dist[k] = full.dist[kf];
+            self.grad[k * n_u..(k + 1) * n_u].copy_from_slice(&full.grad[kf * n_u..(kf + 1) * n_u]);
+        }
+    }
+
     /// Writes the rows, slack boxes and slack costs into `qp`.
     pub fn load(&self, qp: &mut Qp) {
         let p = &self.params;
@@ -434,6 +489,41 @@ impl Clearance {
             .filter(|&k| self.active[k])
             .map(|k| p.penalty_at(self.dist[k]) - p.penalty / SLACK_SCALE * x[self.n_u + k])
             .sum()
+    }
+}
+
+/// The obstacle terms of one predicted position `pos` (sample `h`) with
+/// `d(x, y)/du = (row_x, row_y)` (shared by the tug and ship problems): the
+/// distance cost `w phi(d)` of every obstacle and, for the first
+/// `params.max_obstacles`, the clearance penalty and (with `clearance`) the
+/// linearised row.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn obstacle_terms<const N: usize>(
+    quad: &mut QuadModel,
+    obstacles: &[Obstacle],
+    distance: &DistanceCost,
+    w: f64,
+    params: &ClearanceParams,
+    mut clearance: Option<&mut Clearance>,
+    h: usize,
+    pos: [f64; 2],
+    row_x: &[f64; N],
+    row_y: &[f64; N],
+) {
+    for (j, obstacle) in obstacles.iter().enumerate() {
+        let (d, grad) = obstacle.distance(pos);
+        let (phi, slope, curvature) = distance.eval(d);
+        let mut row = [0.0; N];
+        for (r, (a, b)) in row.iter_mut().zip(row_x.iter().zip(row_y)) {
+            *r = grad[0] * a + grad[1] * b;
+        }
+        quad.curved(phi, slope, curvature, w, &row);
+        if j < params.max_obstacles {
+            quad.value += params.penalty_at(d);
+            if let Some(c) = clearance.as_deref_mut() {
+                c.record(h, j, d, &row);
+            }
+        }
     }
 }
 

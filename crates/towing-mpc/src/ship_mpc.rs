@@ -43,8 +43,8 @@ use crate::formation::FormationMap;
 use crate::obstacle::{DistanceCost, Obstacle};
 use crate::qp::QpBuildError;
 use crate::scp::{
-    angle_difference, box_qp, load_model, set_box, Clearance, ClearanceParams, QuadModel,
-    ScpReport, ScpSettings, TrustRegion,
+    angle_difference, box_qp, load_model, obstacle_terms, set_box, Clearance, ClearanceParams,
+    QuadModel, ScpReport, ScpSettings, TrustRegion,
 };
 use crate::ship::{ShipInput, ShipLinearisation, ShipModel, ShipState};
 use crate::tug_mpc::{rejected, HORIZON};
@@ -118,18 +118,22 @@ pub struct ShipMpc {
     model: ShipModel,
     formation: FormationMap,
     params: ShipMpcParams,
-    qp: Qp,
+    /// Per number of obstacle slots per sample `c` (`0..=max_obstacles`), the QP,
+    /// its clearance rows and its first rate row: a step uses the smallest layout
+    /// holding the obstacles present (unused slots only add rows, see
+    /// [`Clearance::copy_from`]); the last one records the linearisation.
+    variants: Vec<(Qp, Clearance, usize)>,
     trust: TrustRegion,
     plan: [ShipInput; HORIZON],
     candidate: [ShipInput; HORIZON],
     lin: [ShipLinearisation; HORIZON],
+    /// The `(state, plan)` that `lin` and `sens` were computed for: a step from
+    /// the same point (after a rejected step) reuses them.
+    lin_key: Option<(ShipState, [ShipInput; HORIZON])>,
     sens: [[Matrix6x4<f64>; HORIZON]; HORIZON],
     states: [ShipState; HORIZON],
     candidate_states: [ShipState; HORIZON],
     quad: QuadModel,
-    clearance: Clearance,
-    /// First rate row in the QP.
-    rate_row: usize,
 }
 
 impl ShipMpc {
@@ -154,39 +158,43 @@ impl ShipMpc {
             }
         }
         let n_rate = entries.len();
-        let ns = Clearance::slacks(&params.clearance, HORIZON);
-        entries.extend(Clearance::entries(&params.clearance, 4, HORIZON, RATE_ROWS));
-        let (mut qp, mut slots) = box_qp(N + ns, N, RATE_ROWS + ns, &entries)?;
-        for (slot, v) in slots[..n_rate]
-            .iter()
-            .zip([1.0, -1.0, -1.0, 1.0].iter().cycle())
-        {
-            qp.a_mut()[*slot] = *v;
-        }
-        let rate_row = 2 * (N + ns);
-        let clearance_slots = slots.split_off(n_rate);
-        let clearance = Clearance::new(
-            params.clearance,
-            4,
-            HORIZON,
-            rate_row + RATE_ROWS,
-            clearance_slots,
-        );
+        let variants = (0..=params.clearance.max_obstacles)
+            .map(|max_obstacles| {
+                let cp = ClearanceParams {
+                    max_obstacles,
+                    ..params.clearance
+                };
+                let mut entries = entries.clone();
+                let ns = Clearance::slacks(&cp, HORIZON);
+                entries.extend(Clearance::entries(&cp, 4, HORIZON, RATE_ROWS));
+                let (mut qp, mut slots) = box_qp(N + ns, N, RATE_ROWS + ns, &entries)?;
+                for (slot, v) in slots[..n_rate]
+                    .iter()
+                    .zip([1.0, -1.0, -1.0, 1.0].iter().cycle())
+                {
+                    qp.a_mut()[*slot] = *v;
+                }
+                let rate_row = 2 * (N + ns);
+                let clearance_slots = slots.split_off(n_rate);
+                let clearance =
+                    Clearance::new(cp, 4, HORIZON, rate_row + RATE_ROWS, clearance_slots);
+                Ok((qp, clearance, rate_row))
+            })
+            .collect::<Result<Vec<_>, QpBuildError>>()?;
         Ok(ShipMpc {
             model,
             formation,
             params,
-            qp,
+            variants,
             trust: TrustRegion::new(params.scp),
             plan: [[0.0; 4]; HORIZON],
             candidate: [[0.0; 4]; HORIZON],
             lin: [ShipLinearisation::default(); HORIZON],
+            lin_key: None,
             sens: [[Matrix6x4::zeros(); HORIZON]; HORIZON],
             states: [[0.0; 6]; HORIZON],
             candidate_states: [[0.0; 6]; HORIZON],
             quad: QuadModel::new(N),
-            clearance,
-            rate_row,
         })
     }
 
@@ -268,26 +276,34 @@ impl ShipMpc {
 
     /// One SCP step (module docs). Allocation-free.
     pub fn solve_step(&mut self, data: &ShipStepData<'_>) -> ScpReport {
+        let limits: [(f64, f64, f64); 4] = std::array::from_fn(|k| self.limits(k));
         // Project the plan onto the constraints.
         for k in 0..4 {
-            let (lo, hi, rate) = self.limits(k);
+            let (lo, hi, rate) = limits[k];
             let mut before = data.previous[k].clamp(lo, hi);
             for u in &mut self.plan {
                 u[k] = u[k].clamp(lo.max(before - rate), hi.min(before + rate));
                 before = u[k];
             }
         }
-        self.model
-            .linearise_rollout_into(&data.state, &self.plan, &mut self.lin);
+        let key = (data.state, self.plan);
+        if self.lin_key != Some(key) {
+            self.model
+                .linearise_rollout_into(&data.state, &self.plan, &mut self.lin);
+            for h in 0..HORIZON {
+                self.sens[h][h] = self.lin[h].b;
+                for k in 0..h {
+                    self.sens[h][k] = self.lin[h].a * self.sens[h - 1][k];
+                }
+            }
+            self.lin_key = Some(key);
+        }
         for h in 0..HORIZON {
             self.states[h] = self.lin[h].x_next;
-            self.sens[h][h] = self.lin[h].b;
-            for k in 0..h {
-                self.sens[h][k] = self.lin[h].a * self.sens[h - 1][k];
-            }
         }
         self.quad.reset(false);
-        self.clearance.clear();
+        let full = self.variants.len() - 1;
+        self.variants[full].1.clear();
         accumulate(
             &mut self.quad,
             &self.params,
@@ -295,15 +311,13 @@ impl ShipMpc {
             &self.states,
             &self.plan,
             Some(&self.sens),
-            Some(&mut self.clearance),
+            Some(&mut self.variants[full].1),
             data,
         );
-        let cost_before = self.quad.value;
-        load_model(&mut self.qp, &self.quad);
-        self.clearance.load(&mut self.qp);
         let radius = self.trust.radius();
+        let (mut box_lo, mut box_hi) = ([0.0; N], [0.0; N]);
         for k in 0..4 {
-            let (lo, hi, rate) = self.limits(k);
+            let (lo, hi, rate) = limits[k];
             let tr = radius * self.params.trust_scale[k / 2];
             let prev = data.previous[k].clamp(lo, hi);
             for h in 0..HORIZON {
@@ -314,28 +328,45 @@ impl ShipMpc {
                     r = r.min(prev + rate - u);
                 }
                 // du = 0 is feasible after the projection; keep it so with rounding.
-                set_box(&mut self.qp, 4 * h + k, l.min(0.0), r.max(0.0));
-                if h > 0 {
-                    let diff = u - self.plan[h - 1][k];
-                    let row = self.rate_row + 2 * (4 * (h - 1) + k);
-                    self.qp.b_mut()[row] = (rate - diff).max(0.0);
-                    self.qp.b_mut()[row + 1] = (rate + diff).max(0.0);
-                }
+                box_lo[4 * h + k] = l.min(0.0);
+                box_hi[4 * h + k] = r.max(0.0);
             }
         }
-        let outcome = self.qp.solve();
-        let iterations = self.qp.iterations();
+        self.variants[full].1.drop_redundant(&box_lo, &box_hi);
+        let used = self.variants[full].1.slots_used();
+        if used < full {
+            let (small, large) = self.variants.split_at_mut(full);
+            small[used].1.copy_from(&large[0].1);
+        }
+        let (qp, clearance, rate_row) = &mut self.variants[used];
+        let rate_row = *rate_row;
+        let cost_before = self.quad.value;
+        load_model(qp, &self.quad);
+        clearance.load(qp);
+        for j in 0..N {
+            set_box(qp, j, box_lo[j], box_hi[j]);
+        }
+        for k in 0..4 {
+            let rate = limits[k].2;
+            for h in 1..HORIZON {
+                let diff = self.plan[h][k] - self.plan[h - 1][k];
+                let row = rate_row + 2 * (4 * (h - 1) + k);
+                qp.b_mut()[row] = (rate - diff).max(0.0);
+                qp.b_mut()[row + 1] = (rate + diff).max(0.0);
+            }
+        }
+        let outcome = qp.solve();
+        let iterations = qp.iterations();
         if !outcome.is_usable() {
             self.trust.fail();
             return rejected(outcome, cost_before, self.trust.radius(), iterations);
         }
-        let du = self.qp.solution();
-        let predicted =
-            self.quad.predicted_decrease(&du[..N]) + self.clearance.predicted_decrease(du);
+        let du = qp.solution();
+        let predicted = self.quad.predicted_decrease(&du[..N]) + clearance.predicted_decrease(du);
         // The candidate, projected as the plan was (removes the solver's 1e-6
         // tolerance on the constraints).
         for k in 0..4 {
-            let (lo, hi, rate) = self.limits(k);
+            let (lo, hi, rate) = limits[k];
             let mut before = data.previous[k].clamp(lo, hi);
             for h in 0..HORIZON {
                 let v = self.plan[h][k] + du[4 * h + k];
@@ -430,21 +461,18 @@ fn accumulate(
                 quad.residual(res[c], 0.5 * data.rho, data.lambda[i][h][c], &row);
             }
         }
-        for (j, obstacle) in data.obstacles.iter().enumerate() {
-            let (d, grad) = obstacle.distance([x[0], x[1]]);
-            let (phi, slope, curvature) = params.distance.eval(d);
-            let mut row = [0.0; N];
-            for (v, slot) in row.iter_mut().enumerate() {
-                *slot = grad[0] * rows[0][v] + grad[1] * rows[1][v];
-            }
-            quad.curved(phi, slope, curvature, w3, &row);
-            if j < params.clearance.max_obstacles {
-                quad.value += params.clearance.penalty_at(d);
-                if let Some(c) = clearance.as_deref_mut() {
-                    c.record(h, j, d, &row);
-                }
-            }
-        }
+        obstacle_terms(
+            quad,
+            data.obstacles,
+            &params.distance,
+            w3,
+            &params.clearance,
+            clearance.as_deref_mut(),
+            h,
+            [x[0], x[1]],
+            &rows[0],
+            &rows[1],
+        );
     }
 }
 

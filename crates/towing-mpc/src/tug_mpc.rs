@@ -27,9 +27,14 @@
 //!
 //! 5. the hard clearance rows of the design document, linearised, with an L1-
 //!    penalised slack per sample and obstacle slot ([`ClearanceParams`]): the QP
-//!    variables are the 9 increments and `3 max_obstacles` slacks.
+//!    variables are the 9 increments and `3 c` slacks, `c <= max_obstacles` the
+//!    obstacle slots in use (one QP per `c`, built in [`TugMpc::new`]; rows the
+//!    increments' boxes imply are left out).
 //!
-//! Allocation: everything is allocated in [`TugMpc::new`] (the QP and its solver,
+//! A step from the point of the last linearisation (same state, plan and pulls:
+//! after a rejected step) reuses the linearised rollout.
+//!
+//! Allocation: everything is allocated in [`TugMpc::new`] (the QPs and their solvers,
 //! the model buffers); the plan, rollouts, linearisations and sensitivities are
 //! fixed-size arrays. [`TugMpc::solve_step`] only writes into them, and into
 //! Clarabel's preallocated data (`update_P/q/A/b`, then `solve`).
@@ -43,8 +48,8 @@ use nalgebra::Matrix6x3;
 use crate::obstacle::{DistanceCost, Obstacle};
 use crate::qp::{QpBuildError, QpOutcome};
 use crate::scp::{
-    angle_difference, box_qp, load_model, set_box, Clearance, ClearanceParams, QuadModel,
-    ScpReport, ScpSettings, TrustRegion,
+    angle_difference, box_qp, load_model, obstacle_terms, set_box, Clearance, ClearanceParams,
+    QuadModel, ScpReport, ScpSettings, TrustRegion,
 };
 use crate::tug::{TowlinePull, TugInput, TugLinearisation, TugModel, TugState};
 use crate::Qp;
@@ -106,38 +111,53 @@ pub struct TugStepData<'a> {
 pub struct TugMpc {
     model: TugModel,
     params: TugMpcParams,
-    qp: Qp,
+    /// Per number of obstacle slots per sample `c` (`0..=max_obstacles`), the QP
+    /// and its clearance rows: a step uses the smallest layout holding the
+    /// obstacles present (unused slots only add rows, see [`Clearance::copy_from`]);
+    /// the last one records the linearisation.
+    variants: Vec<(Qp, Clearance)>,
     trust: TrustRegion,
     plan: [TugInput; HORIZON],
     candidate: [TugInput; HORIZON],
     lin: [TugLinearisation; HORIZON],
+    /// The `(state, plan, pulls)` that `lin`, `sens` and `states` were computed
+    /// for: a step from the same point (after a rejected step) reuses them.
+    lin_key: Option<(TugState, [TugInput; HORIZON], [TowlinePull; HORIZON])>,
     sens: [[Matrix6x3<f64>; HORIZON]; HORIZON],
     states: [TugState; HORIZON],
     candidate_states: [TugState; HORIZON],
     quad: QuadModel,
-    clearance: Clearance,
 }
 
 impl TugMpc {
     /// The problem for `model`, the plan at zero thrust.
     pub fn new(model: TugModel, params: TugMpcParams) -> Result<TugMpc, QpBuildError> {
-        let ns = Clearance::slacks(&params.clearance, HORIZON);
-        let entries = Clearance::entries(&params.clearance, 3, HORIZON, 0);
-        let (qp, slots) = box_qp(N + ns, N, ns, &entries)?;
-        let clearance = Clearance::new(params.clearance, 3, HORIZON, 2 * (N + ns), slots);
+        let variants = (0..=params.clearance.max_obstacles)
+            .map(|max_obstacles| {
+                let cp = ClearanceParams {
+                    max_obstacles,
+                    ..params.clearance
+                };
+                let ns = Clearance::slacks(&cp, HORIZON);
+                let entries = Clearance::entries(&cp, 3, HORIZON, 0);
+                let (qp, slots) = box_qp(N + ns, N, ns, &entries)?;
+                let clearance = Clearance::new(cp, 3, HORIZON, 2 * (N + ns), slots);
+                Ok((qp, clearance))
+            })
+            .collect::<Result<Vec<_>, QpBuildError>>()?;
         Ok(TugMpc {
             model,
             params,
-            qp,
+            variants,
             trust: TrustRegion::new(params.scp),
             plan: [[0.0; 3]; HORIZON],
             candidate: [[0.0; 3]; HORIZON],
             lin: [TugLinearisation::default(); HORIZON],
+            lin_key: None,
             sens: [[Matrix6x3::zeros(); HORIZON]; HORIZON],
             states: [[0.0; 6]; HORIZON],
             candidate_states: [[0.0; 6]; HORIZON],
             quad: QuadModel::new(N),
-            clearance,
         })
     }
 
@@ -199,50 +219,67 @@ impl TugMpc {
                 *t = t.clamp(-l, l);
             }
         }
-        self.model
-            .linearise_rollout_into(&data.state, &self.plan, &data.pulls, &mut self.lin);
+        let key = (data.state, self.plan, data.pulls);
+        if self.lin_key != Some(key) {
+            self.model.linearise_thrust_rollout_into(
+                &data.state,
+                &self.plan,
+                &data.pulls,
+                &mut self.lin,
+            );
+            for h in 0..HORIZON {
+                self.sens[h][h] = self.lin[h].b;
+                for k in 0..h {
+                    self.sens[h][k] = self.lin[h].a * self.sens[h - 1][k];
+                }
+            }
+            self.lin_key = Some(key);
+        }
         for h in 0..HORIZON {
             self.states[h] = self.lin[h].x_next;
-            self.sens[h][h] = self.lin[h].b;
-            for k in 0..h {
-                self.sens[h][k] = self.lin[h].a * self.sens[h - 1][k];
-            }
         }
         self.quad.reset(false);
-        self.clearance.clear();
+        let full = self.variants.len() - 1;
+        self.variants[full].1.clear();
         accumulate(
             &mut self.quad,
             &self.params,
             &self.states,
             Some(&self.sens),
-            Some(&mut self.clearance),
+            Some(&mut self.variants[full].1),
             data,
         );
-        let cost_before = self.quad.value;
-        load_model(&mut self.qp, &self.quad);
-        self.clearance.load(&mut self.qp);
         let radius = self.trust.radius();
+        let (mut lo, mut hi) = ([0.0; N], [0.0; N]);
         for h in 0..HORIZON {
             for c in 0..3 {
                 let tr = radius * self.params.trust_scale[c];
                 let u = self.plan[h][c];
-                set_box(
-                    &mut self.qp,
-                    3 * h + c,
-                    (-lim[c] - u).max(-tr),
-                    (lim[c] - u).min(tr),
-                );
+                lo[3 * h + c] = (-lim[c] - u).max(-tr);
+                hi[3 * h + c] = (lim[c] - u).min(tr);
             }
         }
-        let outcome = self.qp.solve();
-        let iterations = self.qp.iterations();
+        self.variants[full].1.drop_redundant(&lo, &hi);
+        let used = self.variants[full].1.slots_used();
+        if used < full {
+            let (small, large) = self.variants.split_at_mut(full);
+            small[used].1.copy_from(&large[0].1);
+        }
+        let (qp, clearance) = &mut self.variants[used];
+        let cost_before = self.quad.value;
+        load_model(qp, &self.quad);
+        clearance.load(qp);
+        for j in 0..N {
+            set_box(qp, j, lo[j], hi[j]);
+        }
+        let outcome = qp.solve();
+        let iterations = qp.iterations();
         if !outcome.is_usable() {
             self.trust.fail();
             return rejected(outcome, cost_before, self.trust.radius(), iterations);
         }
-        let du = self.qp.solution();
-        let predicted =
-            self.quad.predicted_decrease(&du[..N]) + self.clearance.predicted_decrease(du);
+        let du = qp.solution();
+        let predicted = self.quad.predicted_decrease(&du[..N]) + clearance.predicted_decrease(du);
         for h in 0..HORIZON {
             for c in 0..3 {
                 self.candidate[h][c] = (self.plan[h][c] + du[3 * h + c]).clamp(-lim[c], lim[c]);
@@ -333,21 +370,18 @@ fn accumulate(
             quad.residual(err[c], w1 + 0.5 * data.rho, data.lambda[h][c], &rows[c]);
             quad.residual(x[3 + c], w2, 0.0, &rows[3 + c]);
         }
-        for (j, obstacle) in data.obstacles.iter().enumerate() {
-            let (d, grad) = obstacle.distance([x[0], x[1]]);
-            let (phi, slope, curvature) = params.distance.eval(d);
-            let mut row = [0.0; N];
-            for (r, (a, b)) in row.iter_mut().zip(rows[0].iter().zip(&rows[1])) {
-                *r = grad[0] * a + grad[1] * b;
-            }
-            quad.curved(phi, slope, curvature, w3, &row);
-            if j < params.clearance.max_obstacles {
-                quad.value += params.clearance.penalty_at(d);
-                if let Some(c) = clearance.as_deref_mut() {
-                    c.record(h, j, d, &row);
-                }
-            }
-        }
+        obstacle_terms(
+            quad,
+            data.obstacles,
+            &params.distance,
+            w3,
+            &params.clearance,
+            clearance.as_deref_mut(),
+            h,
+            [x[0], x[1]],
+            &rows[0],
+            &rows[1],
+        );
     }
 }
 
