@@ -4,8 +4,6 @@
 //! bearings from North positive clockwise (to starboard), radians. The forward
 //! unit vector of a vessel with heading `psi` is `(cos psi, sin psi)`.
 
-use std::f64::consts::{PI, TAU};
-
 use serde::{Deserialize, Serialize};
 
 /// Relative speeds below this (m/s) count as "no relative motion": the CPA is
@@ -16,30 +14,9 @@ use serde::{Deserialize, Serialize};
 /// (0.01 to 0.2 m/s) and far above rounding noise of the velocities.
 pub const MIN_RELATIVE_SPEED: f64 = 1.0e-6;
 
-/// Wraps an angle to `(-pi, pi]` (radians).
-///
-/// `pi` and `-pi` both map to `pi`, so an angle has one representation. Non-finite
-/// input gives NaN.
-///
-/// ```
-/// use towing_guidance::wrap_angle;
-/// use std::f64::consts::PI;
-/// assert_eq!(wrap_angle(-PI), PI);
-/// assert!((wrap_angle(1.5 * PI) + 0.5 * PI).abs() < 1e-15);
-/// ```
-#[must_use]
-pub fn wrap_angle(angle: f64) -> f64 {
-    if angle > -PI && angle <= PI {
-        return angle;
-    }
-    // rem_euclid gives [0, 2 pi) up to rounding, so pi - rem lies in (-pi, pi].
-    let wrapped = PI - (PI - angle).rem_euclid(TAU);
-    if wrapped <= -PI {
-        wrapped + TAU
-    } else {
-        wrapped
-    }
-}
+/// Wraps an angle to `(-pi, pi]` (radians): the plant's own function, so guidance and
+/// plant agree on every heading.
+pub use towing_model::wrap_angle;
 
 /// Bearing of `point` seen from a vessel at `(x, y)` with heading `psi`, relative
 /// to her bow, in `(-pi, pi]`: positive to starboard, negative to port, `pi` dead
@@ -124,6 +101,7 @@ pub(crate) fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+    use std::f64::consts::{PI, TAU};
 
     fn deg(d: f64) -> f64 {
         d.to_radians()

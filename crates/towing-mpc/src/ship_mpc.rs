@@ -485,6 +485,10 @@ mod tests {
     use crate::PredictionParams;
 
     fn ship_mpc() -> ShipMpc {
+        ship_mpc_with(ShipMpcParams::default())
+    }
+
+    fn ship_mpc_with(params: ShipMpcParams) -> ShipMpc {
         let scenario = Scenario::paper().unwrap();
         let model = ShipModel::from_scenario(
             &scenario,
@@ -493,7 +497,7 @@ mod tests {
         )
         .unwrap();
         let formation = FormationMap::from_scenario(&scenario).unwrap();
-        ShipMpc::new(model, formation, ShipMpcParams::default()).unwrap()
+        ShipMpc::new(model, formation, params).unwrap()
     }
 
     /// At rest at the origin heading North; the tugs where the formation wants
@@ -628,15 +632,7 @@ mod tests {
             let mut params = ShipMpcParams::default();
             params.weights[2] = 0.0;
             params.clearance.max_obstacles = max_obstacles;
-            let scenario = Scenario::paper().unwrap();
-            let model = ShipModel::from_scenario(
-                &scenario,
-                HullModel::NonlinearDamping,
-                PredictionParams::default(),
-            )
-            .unwrap();
-            let formation = FormationMap::from_scenario(&scenario).unwrap();
-            let mut mpc = ShipMpc::new(model, formation, params).unwrap();
+            let mut mpc = ship_mpc_with(params);
             let mut data = data_at_rest(&mpc, [3.0, 0.0, 0.0], 0.0);
             data.obstacles = &obstacles;
             data.previous = [0.0; 4]; // at rest, lines slack: holding still is feasible
