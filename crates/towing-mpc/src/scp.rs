@@ -18,6 +18,8 @@
 //! `ratio >= good`, shrinks (x `shrink`, down to `min_radius`) when `ratio < poor`
 //! or the QP gave no usable solution.
 
+use nalgebra::{Matrix6, SMatrix};
+
 use crate::obstacle::{DistanceCost, Obstacle};
 use crate::qp::{upper_index, Pattern, Qp, QpBuildError, QpOutcome};
 
@@ -489,6 +491,27 @@ impl Clearance {
             .filter(|&k| self.active[k])
             .map(|k| p.penalty_at(self.dist[k]) - p.penalty / SLACK_SCALE * x[self.n_u + k])
             .sum()
+    }
+}
+
+/// Condensing (state elimination) of a linearised horizon: with
+/// `x_{h+1} = A_h x_h + B_h u_h`, the sensitivity of the predicted state `h` to input `k`
+/// is `S[h][k] = B_h` for `k = h` and `A_h S[h-1][k]` for `k < h` (zero for `k > h`).
+/// `a[h]`, `b[h]` are the Jacobians of step `h` of the discretised model.
+pub(crate) fn condense<const M: usize, const H: usize>(
+    a: [&Matrix6<f64>; H],
+    b: [&SMatrix<f64, 6, M>; H],
+    sens: &mut [[SMatrix<f64, 6, M>; H]; H],
+) {
+    for h in 0..H {
+        let (before, rest) = sens.split_at_mut(h);
+        let row = &mut rest[0];
+        row[h] = *b[h];
+        if let Some(previous) = before.last() {
+            for (s, p) in row[..h].iter_mut().zip(&previous[..h]) {
+                *s = a[h] * p;
+            }
+        }
     }
 }
 

@@ -43,8 +43,8 @@ use crate::formation::FormationMap;
 use crate::obstacle::{DistanceCost, Obstacle};
 use crate::qp::QpBuildError;
 use crate::scp::{
-    angle_difference, box_qp, load_model, obstacle_terms, set_box, Clearance, ClearanceParams,
-    QuadModel, ScpReport, ScpSettings, TrustRegion,
+    angle_difference, box_qp, condense, load_model, obstacle_terms, set_box, Clearance,
+    ClearanceParams, QuadModel, ScpReport, ScpSettings, TrustRegion,
 };
 use crate::ship::{ShipInput, ShipLinearisation, ShipModel, ShipState};
 use crate::tug_mpc::{rejected, HORIZON};
@@ -290,12 +290,11 @@ impl ShipMpc {
         if self.lin_key != Some(key) {
             self.model
                 .linearise_rollout_into(&data.state, &self.plan, &mut self.lin);
-            for h in 0..HORIZON {
-                self.sens[h][h] = self.lin[h].b;
-                for k in 0..h {
-                    self.sens[h][k] = self.lin[h].a * self.sens[h - 1][k];
-                }
-            }
+            condense(
+                std::array::from_fn(|h| &self.lin[h].a),
+                std::array::from_fn(|h| &self.lin[h].b),
+                &mut self.sens,
+            );
             self.lin_key = Some(key);
         }
         for h in 0..HORIZON {

@@ -48,8 +48,8 @@ use nalgebra::Matrix6x3;
 use crate::obstacle::{DistanceCost, Obstacle};
 use crate::qp::{QpBuildError, QpOutcome};
 use crate::scp::{
-    angle_difference, box_qp, load_model, obstacle_terms, set_box, Clearance, ClearanceParams,
-    QuadModel, ScpReport, ScpSettings, TrustRegion,
+    angle_difference, box_qp, condense, load_model, obstacle_terms, set_box, Clearance,
+    ClearanceParams, QuadModel, ScpReport, ScpSettings, TrustRegion,
 };
 use crate::tug::{TowlinePull, TugInput, TugLinearisation, TugModel, TugState};
 use crate::Qp;
@@ -227,12 +227,11 @@ impl TugMpc {
                 &data.pulls,
                 &mut self.lin,
             );
-            for h in 0..HORIZON {
-                self.sens[h][h] = self.lin[h].b;
-                for k in 0..h {
-                    self.sens[h][k] = self.lin[h].a * self.sens[h - 1][k];
-                }
-            }
+            condense(
+                std::array::from_fn(|h| &self.lin[h].a),
+                std::array::from_fn(|h| &self.lin[h].b),
+                &mut self.sens,
+            );
             self.lin_key = Some(key);
         }
         for h in 0..HORIZON {
