@@ -265,6 +265,7 @@ pub struct ReferenceSystem {
     active: usize,
     latched: u64,
     held: [Option<Situation>; MAX_OBSTACLES],
+    situations: [Option<Situation>; MAX_OBSTACLES],
 }
 
 impl ReferenceSystem {
@@ -277,6 +278,7 @@ impl ReferenceSystem {
             active: 1,
             latched: 0,
             held: [None; MAX_OBSTACLES],
+            situations: [None; MAX_OBSTACLES],
         }
     }
 
@@ -285,6 +287,7 @@ impl ReferenceSystem {
         self.active = 1;
         self.latched = 0;
         self.held = [None; MAX_OBSTACLES];
+        self.situations = [None; MAX_OBSTACLES];
     }
 
     /// The route.
@@ -303,6 +306,15 @@ impl ReferenceSystem {
     #[must_use]
     pub fn active_waypoint(&self) -> usize {
         self.active
+    }
+
+    /// The COLREGS situation of obstacle slot `slot` at the last
+    /// [`update`](Self::update) (the held one of an encounter, else the present
+    /// one, as [`ObstacleAssessment::situation`]); `None` for static hazards, empty
+    /// slots and slots beyond those given.
+    #[must_use]
+    pub fn situation(&self, slot: usize) -> Option<Situation> {
+        self.situations.get(slot).copied().flatten()
     }
 
     /// True while an encounter keeps the route altered.
@@ -374,6 +386,7 @@ impl ReferenceSystem {
         let mut nearest_latched: Option<ObstacleAssessment> = None;
         let mut latched = 0u64;
         let mut held = [None; MAX_OBSTACLES];
+        let mut situations = [None; MAX_OBSTACLES];
         let points = self.route.points();
         let leg = [
             points[self.active - 1].position(),
@@ -393,6 +406,7 @@ impl ReferenceSystem {
                 leg: Some(leg),
             };
             let a = assess_obstacle(&self.params, tow, index, &obstacle, &context);
+            situations[index] = a.situation;
             if a.range < d_ob {
                 d_ob = a.range;
                 nearest = Some(a);
@@ -418,6 +432,7 @@ impl ReferenceSystem {
         }
         self.latched = latched;
         self.held = held;
+        self.situations = situations;
         let altered = latched != 0;
 
         let ship = tow.ship.position();

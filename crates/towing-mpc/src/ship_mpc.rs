@@ -58,7 +58,12 @@ const RATE_ROWS: usize = 2 * 4 * (HORIZON - 1);
 pub struct ShipMpcParams {
     /// `w_S = (w_S1, w_S2, w_S3)`: pose error, velocity, distance (Table 3: 1, 75, 1).
     pub weights: [f64; 3],
-    /// `F_max` (N), eq. (18); `F_min = 0`.
+    /// `F_min` (N), eq. (18), where the paper has 0: a pretension keeping both
+    /// lines taut. With slack lines the formation (eq. (4)-(6)) no longer fixes
+    /// the tugs, the towing angles drift with them, and the next pull starts
+    /// from a crooked formation (`docs/assumptions.md`). 0 is the printed bound.
+    pub min_tension: f64,
+    /// `F_max` (N), eq. (18).
     pub max_tension: f64,
     /// `alpha_max` (rad), eq. (17).
     pub max_angle: f64,
@@ -66,6 +71,18 @@ pub struct ShipMpcParams {
     pub tension_rate: f64,
     /// `|Delta alpha|` per sample (rad), eq. (20).
     pub angle_rate: f64,
+    /// `w_alpha` (1/rad^2): weight of `sum_h alpha_ih^2`, a regulariser the paper
+    /// does not have. Without it the towing angles are free whenever the
+    /// tensions are zero (they then move only the tugs' references), drift with
+    /// the tugs to the bounds, and the next pull starts from a crooked formation
+    /// (`docs/assumptions.md`). 0 reproduces eq. (13) as printed.
+    pub angle_weight: f64,
+    /// `w_F` (1/N^2): weight of `sum_h F_ih^2`, a regulariser the paper does not
+    /// have. Eq. (13) has no input cost, so equal and opposite tensions cost
+    /// nothing and the lines can end in a tug of war at `F_max`; a small `w_F`
+    /// picks the least tension among plans of (nearly) equal cost. 0 reproduces
+    /// eq. (13) as printed.
+    pub tension_weight: f64,
     /// Trust-region scale of `(F, alpha)` (N, rad): the box is `radius * scale`.
     pub trust_scale: [f64; 2],
     /// Trust region.
@@ -80,10 +97,13 @@ impl Default for ShipMpcParams {
     fn default() -> Self {
         ShipMpcParams {
             weights: [1.0, 75.0, 1.0],
+            min_tension: 0.1,
             max_tension: 3.0,
             max_angle: 30f64.to_radians(),
             tension_rate: 0.3,
             angle_rate: 5f64.to_radians(),
+            angle_weight: 0.5,
+            tension_weight: 0.01,
             trust_scale: [1.0, 0.2],
             scp: ScpSettings::default(),
             distance: DistanceCost::default(),
@@ -249,7 +269,7 @@ impl ShipMpc {
     fn limits(&self, k: usize) -> (f64, f64, f64) {
         let p = &self.params;
         if k < 2 {
-            (0.0, p.max_tension, p.tension_rate)
+            (p.min_tension, p.max_tension, p.tension_rate)
         } else {
             (-p.max_angle, p.max_angle, p.angle_rate)
         }
@@ -441,6 +461,20 @@ fn accumulate(
         for c in 0..3 {
             quad.residual(err[c], w1, 0.0, &rows[c]);
             quad.residual(x[3 + c], w2, 0.0, &rows[3 + c]);
+        }
+        for (k, w) in [
+            (0, params.tension_weight),
+            (1, params.tension_weight),
+            (2, params.angle_weight),
+            (3, params.angle_weight),
+        ] {
+            if w > 0.0 {
+                let mut row = [0.0; N];
+                if sens.is_some() {
+                    row[4 * h + k] = 1.0;
+                }
+                quad.residual(plan[h][k], w, 0.0, &row);
+            }
         }
         for i in 0..2 {
             let (f, jac) = formation.tug_reference_linearised(eta, plan[h][2 + i], i);

@@ -1,0 +1,123 @@
+//! Closed loop in Rust, without FMI: the plant's `World` and the controller,
+//! communication step 0.1 s. A development tool and a reference for the FMU runs.
+//!
+//! `cargo run --release -p towing-control --example closed_loop -- [stop_s] [scheme] [csv]`
+use std::io::Write;
+
+use towing_control::{AvoidanceScheme, Controller, ControllerConfig, Measurement};
+use towing_guidance::ObstacleInput;
+use towing_model::{Scenario, World, WorldInputs};
+
+fn measure(world: &World) -> Measurement {
+    let v = |s: &towing_model::VesselState| [s.eta[0], s.eta[1], s.eta[2], s.nu[0], s.nu[1], s.nu[2]];
+    let mut m = Measurement {
+        ship: v(world.ship()),
+        tugs: [v(world.tug(0)), v(world.tug(1))],
+        ..Measurement::default()
+    };
+    for (k, slot) in m.obstacles.iter_mut().enumerate() {
+        let o = world.obstacle(k);
+        *slot = ObstacleInput {
+            x: o.x,
+            y: o.y,
+            psi: o.psi,
+            speed: o.speed,
+            length: o.length,
+            width: o.width,
+            kind: o.kind,
+        };
+    }
+    m
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let stop: f64 = args.get(1).map_or(Ok(1200.0), |s| s.parse())?;
+    let scheme = AvoidanceScheme::from_code(args.get(2).map_or(Ok(1), |s| s.parse())?)?;
+    let scenario = Scenario::paper()?;
+    let mut world = World::new(&scenario, scenario.world_config)?;
+    let mut config = ControllerConfig::new(scenario.clone());
+    config.scheme = scheme;
+    if let Ok(g) = std::env::var("INNER_GAIN") {
+        let g: f64 = g.parse()?;
+        config.inner.gain = [g, g, g];
+    }
+    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+    if let Some(v) = env("W_F") { config.ship.tension_weight = v; }
+    if let Some(v) = env("W_A") { config.ship.angle_weight = v; }
+    if let Some(v) = env("F_MIN") { config.ship.min_tension = v; }
+    if let Some(v) = env("ACCEPT") { config.guidance.acceptance_radius = v; }
+    if let Some(v) = env("RHO") { config.admm.rho = v; }
+    let mut controller = Controller::new(config)?;
+    let mut csv = match args.get(3) {
+        Some(path) => Some(std::io::BufWriter::new(std::fs::File::create(path)?)),
+        None => None,
+    };
+    let h = 0.1;
+    let steps = (stop / h).round() as usize;
+    let per_sample = 10;
+    let mut times = Vec::new();
+    let mut iters = Vec::new();
+    let mut not_converged = 0;
+    let mut min_clear = f64::INFINITY;
+    let wall = std::time::Instant::now();
+    for n in 0..steps {
+        let m = measure(&world);
+        if n % per_sample == 0 {
+            let r = controller.sample(&m)?;
+            times.push(r.compute_time * 1e3);
+            iters.push(r.iterations);
+            not_converged += usize::from(!r.converged);
+            if std::env::var("DEBUG").is_ok() && n % (per_sample * 5) == 0 {
+                eprintln!(
+                    "t {:6.1} ref ({:6.2},{:6.2},{:6.1}) wp {} alt {} F ({:.2},{:.2}) a ({:5.1},{:5.1}) act ({:5.1},{:5.1}) tau1 {:?} tau2 {:?} it {} ship ({:6.2},{:6.2},{:6.1}) u {:.3} v {:.3} r {:.3}",
+                    world.time(), r.reference[0], r.reference[1], r.reference[2].to_degrees(),
+                    r.guidance.active_waypoint, r.guidance.altered, r.command.tension[0], r.command.tension[1],
+                    r.desired_angle[0].to_degrees(), r.desired_angle[1].to_degrees(),
+                    world.towline(0).angle.to_degrees(), world.towline(1).angle.to_degrees(),
+                    r.command.tug_thrust[0].map(|v| (v * 100.0).round() / 100.0), r.command.tug_thrust[1].map(|v| (v * 100.0).round() / 100.0), r.iterations,
+                    m.ship[0], m.ship[1], m.ship[2].to_degrees(), m.ship[3], m.ship[4], m.ship[5]
+                );
+            }
+            if let Some(why) = r.fallback {
+                eprintln!("t = {:.1}: fallback: {why}", world.time());
+            }
+        }
+        let c = controller.command_at((n % per_sample) as f64 * h, &m)?;
+        world.step(&WorldInputs { tug_tau: c.tug_thrust, tension_cmd: c.tension }, h)?;
+        for o in world.obstacles() {
+            let _ = o;
+        }
+        if let Some(f) = csv.as_mut() {
+            let s = world.ship();
+            let (t1, t2) = (world.tug(0), world.tug(1));
+            writeln!(
+                f,
+                "{:.1},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                world.time(), s.eta[0], s.eta[1], s.eta[2], s.nu[0], s.nu[1], s.nu[2],
+                t1.eta[0], t1.eta[1], t1.eta[2], t2.eta[0], t2.eta[1], t2.eta[2],
+                c.tension[0], c.tension[1]
+            )?;
+        }
+        // Clearance to every active obstacle (centre distance minus radius, crude).
+        for k in 0..towing_model::MAX_OBSTACLES {
+            let o = world.obstacle(k);
+            if o.kind == 0 { continue; }
+            for p in [world.ship().eta, world.tug(0).eta, world.tug(1).eta] {
+                let d = (p[0] - o.x).hypot(p[1] - o.y) - 0.5 * o.length.max(o.width);
+                min_clear = min_clear.min(d);
+            }
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    iters.sort_unstable();
+    let s = world.ship();
+    println!(
+        "end t={:.0}: ship at ({:.2}, {:.2}) psi {:.1} deg, u {:.3}; wall {:.2} s; sample ms median {:.2} p99 {:.2} max {:.2}; iterations median {} p99 {} max {}; not converged {}; fallbacks {}; min crude clearance {:.2} m",
+        world.time(), s.eta[0], s.eta[1], s.eta[2].to_degrees(), s.nu[0], wall.elapsed().as_secs_f64(),
+        times[times.len() / 2], times[times.len() * 99 / 100], times[times.len() - 1],
+        iters[iters.len() / 2], iters[iters.len() * 99 / 100], iters[iters.len() - 1], not_converged,
+        controller.fallbacks(), min_clear
+    );
+    Ok(())
+}

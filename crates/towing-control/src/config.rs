@@ -1,0 +1,216 @@
+//! Controller configuration: architecture, avoidance scheme, sample time and
+//! every tuning value, with the defaults of `docs/assumptions.md`.
+
+use towing_guidance::{GuidanceParams, GuidanceSettings, Route};
+use towing_model::{HullModel, Scenario};
+use towing_mpc::{AdmmSettings, PredictionParams, ShipMpcParams, TugMpcParams};
+
+use crate::error::ConfigError;
+
+/// Which optimisation computes the commands (FMI parameter `architecture`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Architecture {
+    /// 1: the distributed MPC, ADMM over the coordination and the tug problems
+    /// (Du et al. 2022, Algorithm 1).
+    #[default]
+    Distributed,
+    /// 2: one MPC over all inputs (eq. (12)), for the paper's Table 7.
+    Centralized,
+}
+
+impl Architecture {
+    /// From the FMI code (1 or 2).
+    ///
+    /// # Errors
+    /// Any other code.
+    pub fn from_code(code: i32) -> Result<Self, ConfigError> {
+        match code {
+            1 => Ok(Architecture::Distributed),
+            2 => Ok(Architecture::Centralized),
+            _ => Err(ConfigError::new(
+                "architecture",
+                format!("must be 1 (distributed) or 2 (centralized), got {code}"),
+            )),
+        }
+    }
+
+    /// The FMI code.
+    #[must_use]
+    pub fn code(self) -> i32 {
+        match self {
+            Architecture::Distributed => 1,
+            Architecture::Centralized => 2,
+        }
+    }
+}
+
+/// The paper's avoidance schemes (section 4.2, Table 6; FMI parameter
+/// `avoidance_scheme`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AvoidanceScheme {
+    /// I: waypoint altering (eq. (8)-(11)) and the distance cost (eq. (13)).
+    #[default]
+    AlterAndCost,
+    /// II: waypoint altering only (`w_S3 = w_i3 = 0`). The hard clearance rows
+    /// stay: safety is never switched off (`docs/controller-design.md`).
+    AlterOnly,
+    /// III: the distance cost only; the reference is the unaltered route.
+    CostOnly,
+}
+
+impl AvoidanceScheme {
+    /// From the FMI code (1, 2 or 3).
+    ///
+    /// # Errors
+    /// Any other code.
+    pub fn from_code(code: i32) -> Result<Self, ConfigError> {
+        match code {
+            1 => Ok(AvoidanceScheme::AlterAndCost),
+            2 => Ok(AvoidanceScheme::AlterOnly),
+            3 => Ok(AvoidanceScheme::CostOnly),
+            _ => Err(ConfigError::new(
+                "avoidance_scheme",
+                format!("must be 1 (I), 2 (II) or 3 (III), got {code}"),
+            )),
+        }
+    }
+
+    /// The FMI code.
+    #[must_use]
+    pub fn code(self) -> i32 {
+        match self {
+            AvoidanceScheme::AlterAndCost => 1,
+            AvoidanceScheme::AlterOnly => 2,
+            AvoidanceScheme::CostOnly => 3,
+        }
+    }
+
+    /// Whether the reference follows the altered waypoint.
+    #[must_use]
+    pub fn alters(self) -> bool {
+        !matches!(self, AvoidanceScheme::CostOnly)
+    }
+
+    /// Whether the distance term of the cost is on.
+    #[must_use]
+    pub fn distance_cost(self) -> bool {
+        !matches!(self, AvoidanceScheme::AlterOnly)
+    }
+}
+
+/// The tugs' inner stabilising loop (`docs/controller-design.md`, "Tug local
+/// MPCs"): at every communication step each tug adds
+/// `K (nu_plan(t) - nu(t))` to its MPC thrust, `K = diag(gain) M` with `M` the
+/// tug's mass matrix including added mass, and `nu_plan` the MPC's predicted
+/// velocity interpolated over the sample; the sum is saturated at the thrust
+/// limits (eq. (19)).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InnerLoopParams {
+    /// Bandwidth per axis (surge, sway, yaw; 1/s, >= 0; all zero turns the loop
+    /// off).
+    pub gain: [f64; 3],
+}
+
+impl Default for InnerLoopParams {
+    /// `[1, 1, 1] 1/s`: moves the linearised TitoNeri's unstable sway-yaw pole
+    /// (up to +0.5 1/s at the paper's speeds) to about -0.5 1/s and leaves the
+    /// MPC's 1 s sample the outer loop (`docs/assumptions.md`).
+    fn default() -> Self {
+        InnerLoopParams {
+            gain: [1.0, 1.0, 1.0],
+        }
+    }
+}
+
+/// Everything the controller needs; [`ControllerConfig::new`] gives the
+/// documented defaults for a scenario.
+#[derive(Debug, Clone)]
+pub struct ControllerConfig {
+    /// Vessels (prediction models), formation, route and waterway.
+    pub scenario: Scenario,
+    /// The prediction models' hull.
+    pub hull: HullModel,
+    /// Distributed or centralized.
+    pub architecture: Architecture,
+    /// Scheme I, II or III.
+    pub scheme: AvoidanceScheme,
+    /// Sample time `T_s` and RK4 substep of the predictions.
+    pub prediction: PredictionParams,
+    /// ADMM penalty, iterations, tolerances.
+    pub admm: AdmmSettings,
+    /// Coordination problem (Table 3 weights, bounds, rate bounds).
+    pub ship: ShipMpcParams,
+    /// Tug problems (Table 3 weights, thrust bounds).
+    pub tug: TugMpcParams,
+    /// Reference system (`d_D`, `theta`, `d_S0`, waterway).
+    pub guidance: GuidanceSettings,
+    /// The tugs' inner loop.
+    pub inner: InnerLoopParams,
+}
+
+impl ControllerConfig {
+    /// The defaults for `scenario`: hull as the scenario's `[simulation]` says,
+    /// distributed, scheme I, `T_s = 1 s`, and the guidance's waterway half width
+    /// and vessel lengths from the scenario.
+    #[must_use]
+    pub fn new(scenario: Scenario) -> ControllerConfig {
+        let guidance = GuidanceSettings {
+            waterway_half_width: scenario.waterway.as_ref().map(|w| w.half_width),
+            ship_length: scenario.ship_data.length,
+            tug_length: scenario.tug_data[0]
+                .length
+                .max(scenario.tug_data[1].length),
+            ..GuidanceSettings::default()
+        };
+        ControllerConfig {
+            hull: scenario.world_config.hull_model,
+            scenario,
+            architecture: Architecture::default(),
+            scheme: AvoidanceScheme::default(),
+            prediction: PredictionParams::default(),
+            admm: AdmmSettings::default(),
+            ship: ShipMpcParams::default(),
+            tug: TugMpcParams::default(),
+            guidance,
+            inner: InnerLoopParams::default(),
+        }
+    }
+
+    /// The route of the scenario for the reference system.
+    ///
+    /// # Errors
+    /// A route the reference system refuses (e.g. repeated points).
+    pub fn route(&self) -> Result<Route, ConfigError> {
+        let r = &self.scenario.route;
+        let points = std::iter::once(&r.origin)
+            .chain(r.waypoints.iter())
+            .chain(std::iter::once(&r.destination))
+            .map(|p| towing_guidance::Pose::new(p.x, p.y, p.psi))
+            .collect();
+        Route::new(points).map_err(|e| ConfigError::new("scenario.route", e.to_string()))
+    }
+
+    /// Checks every value.
+    ///
+    /// # Errors
+    /// The first value out of range, named.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.prediction
+            .validate()
+            .map_err(|e| ConfigError::new(&e.field, e.reason))?;
+        self.admm
+            .validate()
+            .map_err(|e| ConfigError::new(&e.field, e.reason))?;
+        GuidanceParams::new(self.guidance).map_err(|e| ConfigError::new("guidance", e.to_string()))?;
+        for (axis, g) in ["surge", "sway", "yaw"].iter().zip(self.inner.gain) {
+            if !(g.is_finite() && g >= 0.0) {
+                return Err(ConfigError::new(
+                    &format!("inner_loop_gain_{axis}"),
+                    format!("must be finite and >= 0, got {g}"),
+                ));
+            }
+        }
+        self.route()?;
+        Ok(())
+    }
+}

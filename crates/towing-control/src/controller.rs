@@ -1,0 +1,526 @@
+//! The controller: reference system, MPC, fallback and the tugs' inner loop.
+//!
+//! One control sample ([`Controller::sample`], every `T_s`):
+//!
+//! 1. the measurement is checked (every value finite, every active obstacle
+//!    valid); a refused measurement leaves the controller unchanged;
+//! 2. the ship reference system (eq. (8)-(11)) gives `eta_Sd` and the COLREGS
+//!    situation of every target; scheme III follows the unaltered route instead;
+//! 3. the obstacles nearest to the tow (at most the QP's clearance slots) become
+//!    the MPC's obstacles, at their measured pose (held over the horizon);
+//! 4. the MPC (ADMM, Algorithm 1, or the centralized problem) computes the plan;
+//! 5. if a subproblem's last solve failed or the plan is not finite, the
+//!    previous sample's plan, shifted by one sample and held within the bounds
+//!    and rate bounds, is applied instead, the fallback is counted and the
+//!    reason returned (the FMU turns it into `fmi2Warning`), and the next sample
+//!    starts cold.
+//!
+//! Between samples, [`Controller::command_at`] adds the tugs' inner loop
+//! ([`InnerLoopParams`]) to the held tug thrusts; the tensions hold.
+//!
+//! ADMM stopping at `S` iterations without meeting eq. (29) is not a fallback:
+//! Algorithm 1 then applies its last iterate, which satisfies every bound; the
+//! report says `converged = false` and the FMU reports it as a diagnostic.
+
+use std::time::Instant;
+
+use towing_guidance::{
+    body_to_ned, role, GuidanceOutput, GuidanceParams, ObstacleInput, Pose, ReferenceSystem, Role,
+    TowState,
+};
+use towing_model::{VesselData, MAX_OBSTACLES};
+use towing_mpc::{
+    Admm, AppliedCommand, Obstacle, SampleInput, ShipInput, ShipModel, TugInput, HORIZON,
+};
+
+use crate::config::{ControllerConfig, InnerLoopParams};
+use crate::error::{ConfigError, MeasurementError};
+
+/// What the controller reads every step: the plant's outputs.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Measurement {
+    /// Ship `[x, y, psi, u, v, r]` (NED pose, body velocity).
+    pub ship: [f64; 6],
+    /// Tug 1 (aft) and tug 2 (forward), as the ship.
+    pub tugs: [[f64; 6]; 2],
+    /// The obstacle slots (`obstacle[k]`, kind 0 = empty).
+    pub obstacles: [ObstacleInput; MAX_OBSTACLES],
+}
+
+const VESSEL_FIELDS: [&str; 6] = ["x", "y", "psi", "u", "v", "r"];
+const VESSEL_NAMES: [&str; 3] = ["ship", "tug1", "tug2"];
+
+impl Measurement {
+    /// Every value finite, every active obstacle valid.
+    ///
+    /// # Errors
+    /// The first offending input, by its FMI name.
+    pub fn validate(&self) -> Result<(), MeasurementError> {
+        let vessels = [&self.ship, &self.tugs[0], &self.tugs[1]];
+        for (vessel, state) in VESSEL_NAMES.iter().zip(vessels) {
+            for (field, &value) in VESSEL_FIELDS.iter().zip(state.iter()) {
+                if !value.is_finite() {
+                    return Err(MeasurementError::NonFinite {
+                        name: format!("{vessel}.{field}"),
+                        value,
+                    });
+                }
+            }
+        }
+        for (k, o) in self.obstacles.iter().enumerate() {
+            o.obstacle().map_err(|e| MeasurementError::Obstacle {
+                slot: k + 1,
+                reason: e.to_string(),
+            })?;
+        }
+        Ok(())
+    }
+
+    fn tow_state(&self) -> TowState {
+        let pose = |s: &[f64; 6]| Pose::new(s[0], s[1], s[2]);
+        TowState {
+            ship: pose(&self.ship),
+            ship_vel_n: body_to_ned(self.ship[2], self.ship[3], self.ship[4]),
+            tug1: pose(&self.tugs[0]),
+            tug2: pose(&self.tugs[1]),
+        }
+    }
+}
+
+/// The plant's inputs.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Command {
+    /// `tau_Ti = [X, Y, N]` per tug (N, N, N m, tug body frame).
+    pub tug_thrust: [[f64; 3]; 2],
+    /// Commanded towline tensions `[F_1, F_2]` (N).
+    pub tension: [f64; 2],
+}
+
+/// Predicted trajectories of the applied plan (states after samples 1..H).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Prediction {
+    /// Ship `[x, y, psi, u, v, r]`.
+    pub ship: [[f64; 6]; HORIZON],
+    /// Tugs, as the ship.
+    pub tugs: [[[f64; 6]; HORIZON]; 2],
+}
+
+/// Result and diagnostics of one control sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SampleReport {
+    /// The MPC's command (tug thrusts before the inner loop).
+    pub command: Command,
+    /// Desired towing angles `[alpha_1, alpha_2]` (rad) of the applied plan.
+    pub desired_angle: [f64; 2],
+    /// The reference system's output.
+    pub guidance: GuidanceOutput,
+    /// The reference the MPC tracked (`eta_Sd`, or the route waypoint in scheme III).
+    pub reference: [f64; 3],
+    /// COLREGS situation code per obstacle slot (`Situation::code`; -1: static
+    /// hazard or empty slot).
+    pub situation: [i32; MAX_OBSTACLES],
+    /// The tow's role per slot: 1 give-way, 2 stand-on, 0 none.
+    pub role: [i32; MAX_OBSTACLES],
+    /// ADMM iterations (1 for the centralized problem's single SCP loop count).
+    pub iterations: usize,
+    /// Whether eq. (29) stopped the ADMM.
+    pub converged: bool,
+    /// Last primal residual per tug.
+    pub r_pri: [f64; 2],
+    /// Last dual residual per tug.
+    pub r_dual: [f64; 2],
+    /// Wall time of the sample (s).
+    pub compute_time: f64,
+    /// Why the fallback plan was applied, if it was.
+    pub fallback: Option<&'static str>,
+    /// Fallbacks since instantiation.
+    pub fallbacks: u64,
+    /// Predicted trajectories of the plan.
+    pub prediction: Prediction,
+}
+
+/// The controller (module docs).
+#[derive(Debug)]
+pub struct Controller {
+    config: ControllerConfig,
+    guidance: ReferenceSystem,
+    admm: Admm,
+    inner_k: [[[f64; 3]; 3]; 2],
+    thrust_limit: [[f64; 3]; 2],
+    applied: AppliedCommand,
+    /// The previous sample's plans, shifted: the fallback.
+    spare_ship: [ShipInput; HORIZON],
+    spare_tugs: [[TugInput; HORIZON]; 2],
+    have_spare: bool,
+    /// Tug velocities at the start of the sample and predicted at its end.
+    nu_start: [[f64; 3]; 2],
+    nu_end: [[f64; 3]; 2],
+    fallbacks: u64,
+    mpc_obstacles: [Obstacle; MAX_OBSTACLES],
+}
+
+fn mass_matrix(d: &VesselData) -> [[f64; 3]; 3] {
+    // Fossen (2011), eq. (6.46) and (6.52): M = M_RB + M_A, symmetric part.
+    let m = d.mass;
+    let c = 0.5 * (m * d.x_g - d.y_rdot + m * d.x_g - d.n_vdot);
+    [
+        [m - d.x_udot, 0.0, 0.0],
+        [0.0, m - d.y_vdot, c],
+        [0.0, c, d.inertia_z - d.n_rdot],
+    ]
+}
+
+impl Controller {
+    /// Builds every solver once (no allocation per sample afterwards).
+    ///
+    /// # Errors
+    /// A value out of range, or a solver that cannot be set up, named.
+    pub fn new(config: ControllerConfig) -> Result<Controller, ConfigError> {
+        config.validate()?;
+        let guidance = ReferenceSystem::new(
+            config.route()?,
+            GuidanceParams::new(config.guidance)
+                .map_err(|e| ConfigError::new("guidance", e.to_string()))?,
+        );
+        let mut ship_params = config.ship;
+        let mut tug_params = config.tug;
+        if !config.scheme.distance_cost() {
+            ship_params.weights[2] = 0.0;
+            tug_params.weights[2] = 0.0;
+        }
+        let admm = build_admm(&config, ship_params, tug_params)?;
+        let s = &config.scenario;
+        let inner_k = std::array::from_fn(|i| {
+            let m = mass_matrix(&s.tug_data[i]);
+            std::array::from_fn(|r| std::array::from_fn(|c| config.inner.gain[r] * m[r][c]))
+        });
+        let thrust_limit = std::array::from_fn(|i| {
+            let d = &s.tug_data[i];
+            let l = tug_params.thrust_limit;
+            [
+                l[0].min(d.max_surge_force),
+                l[1].min(d.max_sway_force),
+                l[2].min(d.max_yaw_moment),
+            ]
+        });
+        Ok(Controller {
+            config,
+            guidance,
+            admm,
+            inner_k,
+            thrust_limit,
+            applied: AppliedCommand::default(),
+            spare_ship: [[0.0; 4]; HORIZON],
+            spare_tugs: [[[0.0; 3]; HORIZON]; 2],
+            have_spare: false,
+            nu_start: [[0.0; 3]; 2],
+            nu_end: [[0.0; 3]; 2],
+            fallbacks: 0,
+            mpc_obstacles: [Obstacle::Circle {
+                centre: [0.0; 2],
+                radius: 1.0,
+            }; MAX_OBSTACLES],
+        })
+    }
+
+    /// The configuration.
+    #[must_use]
+    pub fn config(&self) -> &ControllerConfig {
+        &self.config
+    }
+
+    /// Fallbacks since instantiation.
+    #[must_use]
+    pub fn fallbacks(&self) -> u64 {
+        self.fallbacks
+    }
+
+    /// The command applied in the last sample.
+    #[must_use]
+    pub fn applied(&self) -> &AppliedCommand {
+        &self.applied
+    }
+
+    /// One control sample (module docs).
+    ///
+    /// # Errors
+    /// A refused measurement; nothing changes then.
+    pub fn sample(&mut self, m: &Measurement) -> Result<SampleReport, MeasurementError> {
+        let start = Instant::now();
+        m.validate()?;
+        let tow = m.tow_state();
+        let guidance = self
+            .guidance
+            .update(&tow, &m.obstacles)
+            .map_err(|e| MeasurementError::Obstacle {
+                slot: 0,
+                reason: e.to_string(),
+            })?;
+        let target = if self.config.scheme.alters() {
+            guidance.eta_sd
+        } else {
+            guidance.route_waypoint
+        };
+        let reference = target.eta();
+        let mut situation = [-1; MAX_OBSTACLES];
+        let mut roles = [0; MAX_OBSTACLES];
+        let status = self.config.guidance.colregs.tow_status;
+        for k in 0..MAX_OBSTACLES {
+            if let Some(s) = self.guidance.situation(k) {
+                situation[k] = s.code();
+                roles[k] = match role(s, status) {
+                    Some(Role::GiveWay) => 1,
+                    Some(Role::StandOn) => 2,
+                    None => 0,
+                };
+            }
+        }
+        let n_obstacles = self.select_obstacles(m);
+        let input = SampleInput {
+            ship: m.ship,
+            tugs: m.tugs,
+            previous: self.applied,
+            reference: [reference; HORIZON],
+            obstacles: &self.mpc_obstacles[..n_obstacles],
+        };
+        let report = self.admm.solve_sample(&input);
+        let ship_plan = *self.admm.ship().plan();
+        let tug_plans = [*self.admm.tug(0).plan(), *self.admm.tug(1).plan()];
+        let finite = ship_plan.iter().flatten().all(|v| v.is_finite())
+            && tug_plans.iter().flatten().flatten().all(|v| v.is_finite());
+        let fallback = if report.last_step_failed() {
+            Some("a subproblem's last QP solve failed")
+        } else if !finite {
+            Some("the plan is not finite")
+        } else {
+            None
+        };
+        let (ship_cmd, tug_cmd) = if fallback.is_some() {
+            self.fallbacks += 1;
+            let (s, t) = self.fallback_command();
+            self.admm.reset();
+            (s, t)
+        } else {
+            (ship_plan[0], [tug_plans[0][0], tug_plans[1][0]])
+        };
+        // The next sample's spare plan, and the warm start.
+        if fallback.is_none() {
+            let shift = |h: usize| (h + 1).min(HORIZON - 1);
+            self.spare_ship = std::array::from_fn(|h| ship_plan[shift(h)]);
+            self.spare_tugs = std::array::from_fn(|i| std::array::from_fn(|h| tug_plans[i][shift(h)]));
+            self.have_spare = true;
+            self.admm.shift();
+        } else {
+            let shift = |h: usize| (h + 1).min(HORIZON - 1);
+            self.spare_ship = std::array::from_fn(|h| self.spare_ship[shift(h)]);
+            self.spare_tugs =
+                std::array::from_fn(|i| std::array::from_fn(|h| self.spare_tugs[i][shift(h)]));
+        }
+        self.applied = AppliedCommand {
+            ship: ship_cmd,
+            tugs: tug_cmd,
+        };
+        let prediction = self.prediction(m, fallback.is_none());
+        for i in 0..2 {
+            self.nu_start[i] = [m.tugs[i][3], m.tugs[i][4], m.tugs[i][5]];
+            self.nu_end[i] = [
+                prediction.tugs[i][0][3],
+                prediction.tugs[i][0][4],
+                prediction.tugs[i][0][5],
+            ];
+        }
+        Ok(SampleReport {
+            command: Command {
+                tug_thrust: tug_cmd,
+                tension: [ship_cmd[0], ship_cmd[1]],
+            },
+            desired_angle: [ship_cmd[2], ship_cmd[3]],
+            guidance,
+            reference,
+            situation,
+            role: roles,
+            iterations: report.iterations,
+            converged: report.converged,
+            r_pri: report.r_pri,
+            r_dual: report.r_dual,
+            compute_time: start.elapsed().as_secs_f64(),
+            fallback,
+            fallbacks: self.fallbacks,
+            prediction,
+        })
+    }
+
+    /// The command at `elapsed` seconds after the last sample, with the tugs'
+    /// inner loop on the measured velocities; the tensions hold.
+    ///
+    /// # Errors
+    /// A non-finite tug velocity, by name.
+    pub fn command_at(&self, elapsed: f64, m: &Measurement) -> Result<Command, MeasurementError> {
+        let s = (elapsed / self.config.prediction.sample_time).clamp(0.0, 1.0);
+        let mut tug_thrust = self.applied.tugs;
+        for i in 0..2 {
+            for c in 0..3 {
+                let value = m.tugs[i][3 + c];
+                if !value.is_finite() {
+                    return Err(MeasurementError::NonFinite {
+                        name: format!("{}.{}", VESSEL_NAMES[1 + i], VESSEL_FIELDS[3 + c]),
+                        value,
+                    });
+                }
+            }
+            let err: [f64; 3] = std::array::from_fn(|c| {
+                self.nu_start[i][c] + s * (self.nu_end[i][c] - self.nu_start[i][c])
+                    - m.tugs[i][3 + c]
+            });
+            for r in 0..3 {
+                let k = &self.inner_k[i][r];
+                let extra = k[0] * err[0] + k[1] * err[1] + k[2] * err[2];
+                let l = self.thrust_limit[i][r];
+                tug_thrust[i][r] = (tug_thrust[i][r] + extra).clamp(-l, l);
+            }
+        }
+        Ok(Command {
+            tug_thrust,
+            tension: [self.applied.ship[0], self.applied.ship[1]],
+        })
+    }
+
+    /// The inner loop's parameters.
+    #[must_use]
+    pub fn inner_loop(&self) -> InnerLoopParams {
+        self.config.inner
+    }
+
+    /// The spare plan's first sample, within the bounds and rate bounds of the
+    /// applied command (zero tension and thrust without a spare plan: the
+    /// safest command, the tow drifts to rest).
+    fn fallback_command(&self) -> (ShipInput, [TugInput; 2]) {
+        let p = &self.config.ship;
+        let prev = self.applied.ship;
+        let wanted = if self.have_spare {
+            self.spare_ship[0]
+        } else {
+            [0.0; 4]
+        };
+        let mut ship = [0.0; 4];
+        for i in 0..2 {
+            let lo = (prev[i] - p.tension_rate).max(p.min_tension);
+            let hi = (prev[i] + p.tension_rate).min(p.max_tension);
+            ship[i] = finite_or(wanted[i], prev[i]).clamp(lo.min(hi), hi);
+            let lo = (prev[2 + i] - p.angle_rate).max(-p.max_angle);
+            let hi = (prev[2 + i] + p.angle_rate).min(p.max_angle);
+            ship[2 + i] = finite_or(wanted[2 + i], prev[2 + i]).clamp(lo.min(hi), hi);
+        }
+        let tugs = std::array::from_fn(|i| {
+            let w = if self.have_spare {
+                self.spare_tugs[i][0]
+            } else {
+                [0.0; 3]
+            };
+            std::array::from_fn(|c| {
+                let l = self.thrust_limit[i][c];
+                finite_or(w[c], 0.0).clamp(-l, l)
+            })
+        });
+        (ship, tugs)
+    }
+
+    /// Copies the nearest obstacles (by range from the tow) into the MPC's list;
+    /// returns how many.
+    fn select_obstacles(&mut self, m: &Measurement) -> usize {
+        let slots = self.config.ship.clearance.max_obstacles.min(self.config.tug.clearance.max_obstacles);
+        let points = [
+            [m.ship[0], m.ship[1]],
+            [m.tugs[0][0], m.tugs[0][1]],
+            [m.tugs[1][0], m.tugs[1][1]],
+        ];
+        let mut candidates: [(f64, usize); MAX_OBSTACLES] = [(f64::INFINITY, 0); MAX_OBSTACLES];
+        let mut n = 0;
+        for (k, o) in m.obstacles.iter().enumerate() {
+            // Validated in `sample`.
+            let Ok(Some(_)) = o.obstacle() else { continue };
+            let obstacle = mpc_obstacle(o);
+            let range = points
+                .iter()
+                .map(|&p| obstacle.distance(p).0)
+                .fold(f64::INFINITY, f64::min);
+            candidates[n] = (range, k);
+            n += 1;
+        }
+        candidates[..n].sort_by(|a, b| a.0.total_cmp(&b.0));
+        let used = n.min(slots);
+        for (j, &(_, k)) in candidates[..used].iter().enumerate() {
+            self.mpc_obstacles[j] = mpc_obstacle(&m.obstacles[k]);
+        }
+        used
+    }
+
+    fn prediction(&self, m: &Measurement, from_plan: bool) -> Prediction {
+        let mut out = Prediction::default();
+        if from_plan {
+            out.ship = *self.admm.ship().predicted_states();
+            for i in 0..2 {
+                out.tugs[i] = *self.admm.tug(i).predicted_states();
+            }
+        } else {
+            let model: &ShipModel = self.admm.ship().model();
+            out.ship = model.rollout::<HORIZON>(&m.ship, &[self.applied.ship; HORIZON]);
+            for i in 0..2 {
+                out.tugs[i] = [m.tugs[i]; HORIZON];
+            }
+        }
+        out
+    }
+}
+
+fn finite_or(v: f64, default: f64) -> f64 {
+    if v.is_finite() {
+        v
+    } else {
+        default
+    }
+}
+
+/// The MPC's shape of an obstacle slot: a circle of radius `max(L, W) / 2`, or
+/// the ellipse with semi-axes `L / 2`, `W / 2` along the target's course.
+fn mpc_obstacle(o: &ObstacleInput) -> Obstacle {
+    if o.kind == 1 {
+        Obstacle::Circle {
+            centre: [o.x, o.y],
+            radius: 0.5 * o.length.max(o.width),
+        }
+    } else {
+        Obstacle::Ellipse {
+            centre: [o.x, o.y],
+            semi_major: 0.5 * o.length,
+            semi_minor: 0.5 * o.width.min(o.length),
+            orientation: o.psi,
+        }
+    }
+}
+
+fn build_admm(
+    config: &ControllerConfig,
+    ship_params: towing_mpc::ShipMpcParams,
+    tug_params: towing_mpc::TugMpcParams,
+) -> Result<Admm, ConfigError> {
+    use towing_mpc::{FormationMap, ShipMpc, TugModel, TugMpc};
+    let s = &config.scenario;
+    let err = |what: &str, e: String| ConfigError::new(what, e);
+    let ship = ShipMpc::new(
+        ShipModel::from_scenario(s, config.hull, config.prediction)
+            .map_err(|e| err("scenario.ship", e.to_string()))?,
+        FormationMap::from_scenario(s).map_err(|e| err("scenario", e.to_string()))?,
+        ship_params,
+    )
+    .map_err(|e| err("ship MPC", format!("{e:?}")))?;
+    let tug = |i: usize| -> Result<TugMpc, ConfigError> {
+        TugMpc::new(
+            TugModel::from_scenario(s, i, config.hull, config.prediction)
+                .map_err(|e| err("scenario.tug", e.to_string()))?,
+            tug_params,
+        )
+        .map_err(|e| err("tug MPC", format!("{e:?}")))
+    };
+    Admm::new(ship, [tug(0)?, tug(1)?], config.admm).map_err(|e| err(&e.field, e.reason))
+}
