@@ -2,6 +2,9 @@
 //! communication step 0.1 s. A development tool and a reference for the FMU runs.
 //!
 //! `cargo run --release -p towing-control --example closed_loop -- [stop_s] [scheme] [csv]`
+// A command-line tool: printing is its output.
+#![allow(clippy::print_stdout, clippy::print_stderr)]
+
 use std::io::Write;
 
 use towing_control::{AvoidanceScheme, Controller, ControllerConfig, Measurement};
@@ -9,7 +12,8 @@ use towing_guidance::ObstacleInput;
 use towing_model::{Scenario, World, WorldInputs};
 
 fn measure(world: &World) -> Measurement {
-    let v = |s: &towing_model::VesselState| [s.eta[0], s.eta[1], s.eta[2], s.nu[0], s.nu[1], s.nu[2]];
+    let v =
+        |s: &towing_model::VesselState| [s.eta[0], s.eta[1], s.eta[2], s.nu[0], s.nu[1], s.nu[2]];
     let mut m = Measurement {
         ship: v(world.ship()),
         tugs: [v(world.tug(0)), v(world.tug(1))],
@@ -34,7 +38,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let stop: f64 = args.get(1).map_or(Ok(1200.0), |s| s.parse())?;
     let scheme = AvoidanceScheme::from_code(args.get(2).map_or(Ok(1), |s| s.parse())?)?;
-    let scenario = Scenario::paper()?;
+    let mut scenario = Scenario::paper()?;
+    if std::env::var("NO_OBST").is_ok() {
+        scenario.obstacles.clear();
+    }
     let mut world = World::new(&scenario, scenario.world_config)?;
     let mut config = ControllerConfig::new(scenario.clone());
     config.scheme = scheme;
@@ -43,11 +50,36 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         config.inner.gain = [g, g, g];
     }
     let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
-    if let Some(v) = env("W_F") { config.ship.tension_weight = v; }
-    if let Some(v) = env("W_A") { config.ship.angle_weight = v; }
-    if let Some(v) = env("F_MIN") { config.ship.min_tension = v; }
-    if let Some(v) = env("ACCEPT") { config.guidance.acceptance_radius = v; }
-    if let Some(v) = env("RHO") { config.admm.rho = v; }
+    if let Some(v) = env("W_F") {
+        config.ship.tension_weight = v;
+    }
+    if let Some(v) = env("W_A") {
+        config.ship.angle_weight = v;
+    }
+    if let Some(v) = env("F_MIN") {
+        config.ship.min_tension = v;
+    }
+    if let Some(v) = env("ACCEPT") {
+        config.guidance.acceptance_radius = v;
+    }
+    if let Some(v) = env("RHO") {
+        config.admm.rho = v;
+    }
+    if let Some(v) = env("LOS") {
+        config.los_distance = v;
+    }
+    if let Some(v) = env("LOOKAHEAD") {
+        config.lookahead = v;
+    }
+    if let Some(v) = env("W_S1") {
+        config.ship.weights[0] = v;
+    }
+    if let Some(v) = env("W_S2") {
+        config.ship.weights[1] = v;
+    }
+    if let Some(v) = env("W_T2") {
+        config.tug.weights[1] = v;
+    }
     let mut controller = Controller::new(config)?;
     let mut csv = match args.get(3) {
         Some(path) => Some(std::io::BufWriter::new(std::fs::File::create(path)?)),
@@ -68,6 +100,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             times.push(r.compute_time * 1e3);
             iters.push(r.iterations);
             not_converged += usize::from(!r.converged);
+            if let (Ok(a), Ok(b)) = (
+                std::env::var("TRACE_FROM").map(|v| v.parse::<f64>().unwrap_or(0.0)),
+                std::env::var("TRACE_TO").map(|v| v.parse::<f64>().unwrap_or(0.0)),
+            ) {
+                let t = world.time();
+                if t >= a && t <= b {
+                    let (sp, cp) = m.ship[2].sin_cos();
+                    let rel = |p: &[f64; 6]| {
+                        let (dx, dy) = (p[0] - m.ship[0], p[1] - m.ship[1]);
+                        (cp * dx + sp * dy, -sp * dx + cp * dy)
+                    };
+                    let (f2, l2) = rel(&m.tugs[1]);
+                    let (f1, l1) = rel(&m.tugs[0]);
+                    eprintln!("t {t:6.1} psi {:6.1} r {:6.3} | F {:.2} {:.2} a {:6.1} {:6.1} | tug2 rel ({f2:5.2},{l2:5.2}) psi {:6.1} nu ({:.3},{:.3},{:.3}) tau {:?} | tug1 rel ({f1:5.2},{l1:5.2}) tau {:?} | it {} rp {:.1e} rd {:.1e} | pred ship ({:.2},{:.2},{:.1})",
+                        m.ship[2].to_degrees(), m.ship[5], r.command.tension[0], r.command.tension[1], r.desired_angle[0].to_degrees(), r.desired_angle[1].to_degrees(),
+                        m.tugs[1][2].to_degrees(), m.tugs[1][3], m.tugs[1][4], m.tugs[1][5], r.command.tug_thrust[1].map(|v| (v * 100.0).round() / 100.0), r.command.tug_thrust[0].map(|v| (v * 100.0).round() / 100.0),
+                        r.iterations, r.r_pri[1], r.r_dual[1], r.prediction.ship[2][0], r.prediction.ship[2][1], r.prediction.ship[2][2].to_degrees());
+                }
+            }
             if std::env::var("DEBUG").is_ok() && n % (per_sample * 5) == 0 {
                 eprintln!(
                     "t {:6.1} ref ({:6.2},{:6.2},{:6.1}) wp {} alt {} F ({:.2},{:.2}) a ({:5.1},{:5.1}) act ({:5.1},{:5.1}) tau1 {:?} tau2 {:?} it {} ship ({:6.2},{:6.2},{:6.1}) u {:.3} v {:.3} r {:.3}",
@@ -84,7 +135,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
         let c = controller.command_at((n % per_sample) as f64 * h, &m)?;
-        world.step(&WorldInputs { tug_tau: c.tug_thrust, tension_cmd: c.tension }, h)?;
+        world.step(
+            &WorldInputs {
+                tug_tau: c.tug_thrust,
+                tension_cmd: c.tension,
+            },
+            h,
+        )?;
         for o in world.obstacles() {
             let _ = o;
         }
@@ -94,15 +151,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             writeln!(
                 f,
                 "{:.1},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-                world.time(), s.eta[0], s.eta[1], s.eta[2], s.nu[0], s.nu[1], s.nu[2],
-                t1.eta[0], t1.eta[1], t1.eta[2], t2.eta[0], t2.eta[1], t2.eta[2],
-                c.tension[0], c.tension[1]
+                world.time(),
+                s.eta[0],
+                s.eta[1],
+                s.eta[2],
+                s.nu[0],
+                s.nu[1],
+                s.nu[2],
+                t1.eta[0],
+                t1.eta[1],
+                t1.eta[2],
+                t2.eta[0],
+                t2.eta[1],
+                t2.eta[2],
+                c.tension[0],
+                c.tension[1]
             )?;
         }
         // Clearance to every active obstacle (centre distance minus radius, crude).
         for k in 0..towing_model::MAX_OBSTACLES {
             let o = world.obstacle(k);
-            if o.kind == 0 { continue; }
+            if o.kind == 0 {
+                continue;
+            }
             for p in [world.ship().eta, world.tug(0).eta, world.tug(1).eta] {
                 let d = (p[0] - o.x).hypot(p[1] - o.y) - 0.5 * o.length.max(o.width);
                 min_clear = min_clear.min(d);

@@ -146,6 +146,18 @@ pub struct ControllerConfig {
     pub guidance: GuidanceSettings,
     /// The tugs' inner loop.
     pub inner: InnerLoopParams,
+    /// Line-of-sight distance (m): while the ship is farther than this from the
+    /// reference waypoint, the reference heading is the bearing from the ship
+    /// to the waypoint (line of sight, Fossen 2011, section 10.3.2) instead of
+    /// the waypoint's heading of Table 4 / eq. (11); 0 turns it off. On the
+    /// route the two are equal; off the route (after an avoidance) the printed
+    /// heading and a short horizon leave the ship in a local minimum beside
+    /// its waypoint (`docs/assumptions.md`).
+    pub los_distance: f64,
+    /// Lookahead distance (m) of the tracked point on the active leg
+    /// ([`Controller`](crate::Controller) docs); 0 tracks the reference
+    /// system's waypoint `eta_Sd` itself, as the paper does.
+    pub lookahead: f64,
 }
 
 impl ControllerConfig {
@@ -157,11 +169,10 @@ impl ControllerConfig {
         let guidance = GuidanceSettings {
             waterway_half_width: scenario.waterway.as_ref().map(|w| w.half_width),
             ship_length: scenario.ship_data.length,
-            tug_length: scenario.tug_data[0]
-                .length
-                .max(scenario.tug_data[1].length),
+            tug_length: scenario.tug_data[0].length.max(scenario.tug_data[1].length),
             ..GuidanceSettings::default()
         };
+        let scenario_ship_length = scenario.ship_data.length;
         ControllerConfig {
             hull: scenario.world_config.hull_model,
             scenario,
@@ -173,6 +184,8 @@ impl ControllerConfig {
             tug: TugMpcParams::default(),
             guidance,
             inner: InnerLoopParams::default(),
+            los_distance: 2.0 * scenario_ship_length,
+            lookahead: 3.0,
         }
     }
 
@@ -201,7 +214,8 @@ impl ControllerConfig {
         self.admm
             .validate()
             .map_err(|e| ConfigError::new(&e.field, e.reason))?;
-        GuidanceParams::new(self.guidance).map_err(|e| ConfigError::new("guidance", e.to_string()))?;
+        GuidanceParams::new(self.guidance)
+            .map_err(|e| ConfigError::new("guidance", e.to_string()))?;
         for (axis, g) in ["surge", "sway", "yaw"].iter().zip(self.inner.gain) {
             if !(g.is_finite() && g >= 0.0) {
                 return Err(ConfigError::new(
@@ -209,6 +223,18 @@ impl ControllerConfig {
                     format!("must be finite and >= 0, got {g}"),
                 ));
             }
+        }
+        if !(self.lookahead.is_finite() && self.lookahead >= 0.0) {
+            return Err(ConfigError::new(
+                "lookahead",
+                format!("must be finite and >= 0, got {}", self.lookahead),
+            ));
+        }
+        if !(self.los_distance.is_finite() && self.los_distance >= 0.0) {
+            return Err(ConfigError::new(
+                "los_distance",
+                format!("must be finite and >= 0, got {}", self.los_distance),
+            ));
         }
         self.route()?;
         Ok(())

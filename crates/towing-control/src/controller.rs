@@ -203,13 +203,18 @@ impl Controller {
                 l[2].min(d.max_yaw_moment),
             ]
         });
+        let f0 = config.ship.min_tension;
         Ok(Controller {
             config,
             guidance,
             admm,
             inner_k,
             thrust_limit,
-            applied: AppliedCommand::default(),
+            // The lines start at their pretension (`min_tension`), straight.
+            applied: AppliedCommand {
+                ship: [f0, f0, 0.0, 0.0],
+                tugs: [[0.0; 3]; 2],
+            },
             spare_ship: [[0.0; 4]; HORIZON],
             spare_tugs: [[[0.0; 3]; HORIZON]; 2],
             have_spare: false,
@@ -249,19 +254,19 @@ impl Controller {
         let start = Instant::now();
         m.validate()?;
         let tow = m.tow_state();
-        let guidance = self
-            .guidance
-            .update(&tow, &m.obstacles)
-            .map_err(|e| MeasurementError::Obstacle {
-                slot: 0,
-                reason: e.to_string(),
-            })?;
+        let guidance =
+            self.guidance
+                .update(&tow, &m.obstacles)
+                .map_err(|e| MeasurementError::Obstacle {
+                    slot: 0,
+                    reason: e.to_string(),
+                })?;
         let target = if self.config.scheme.alters() {
             guidance.eta_sd
         } else {
             guidance.route_waypoint
         };
-        let reference = target.eta();
+        let reference = self.reference(&m.ship, guidance.active_waypoint, target);
         let mut situation = [-1; MAX_OBSTACLES];
         let mut roles = [0; MAX_OBSTACLES];
         let status = self.config.guidance.colregs.tow_status;
@@ -307,7 +312,8 @@ impl Controller {
         if fallback.is_none() {
             let shift = |h: usize| (h + 1).min(HORIZON - 1);
             self.spare_ship = std::array::from_fn(|h| ship_plan[shift(h)]);
-            self.spare_tugs = std::array::from_fn(|i| std::array::from_fn(|h| tug_plans[i][shift(h)]));
+            self.spare_tugs =
+                std::array::from_fn(|i| std::array::from_fn(|h| tug_plans[i][shift(h)]));
             self.have_spare = true;
             self.admm.shift();
         } else {
@@ -372,17 +378,65 @@ impl Controller {
                 self.nu_start[i][c] + s * (self.nu_end[i][c] - self.nu_start[i][c])
                     - m.tugs[i][3 + c]
             });
-            for r in 0..3 {
-                let k = &self.inner_k[i][r];
+            for ((tau, k), l) in tug_thrust[i]
+                .iter_mut()
+                .zip(&self.inner_k[i])
+                .zip(self.thrust_limit[i])
+            {
                 let extra = k[0] * err[0] + k[1] * err[1] + k[2] * err[2];
-                let l = self.thrust_limit[i][r];
-                tug_thrust[i][r] = (tug_thrust[i][r] + extra).clamp(-l, l);
+                *tau = (*tau + extra).clamp(-l, l);
             }
         }
         Ok(Command {
             tug_thrust,
             tension: [self.applied.ship[0], self.applied.ship[1]],
         })
+    }
+
+    /// The pose the MPC tracks (`docs/controller-design.md`, "Reference"): with
+    /// `lookahead = 0` the reference system's waypoint `eta_Sd` (eq. (8)-(11));
+    /// otherwise the point `lookahead` metres ahead of the ship's projection on
+    /// the active leg (previous waypoint to `target`, the altered one while
+    /// altered), continued onto the next leg past `target`, and the destination
+    /// on the last leg (lookahead-based line of sight, Fossen 2011, section
+    /// 10.3.2). The heading is the bearing from the ship to that point while it
+    /// is farther than `los_distance`, else the point's route heading.
+    fn reference(&self, ship: &[f64; 6], active: usize, target: Pose) -> [f64; 3] {
+        let points = self.guidance.route().points();
+        let last = points.len() - 1;
+        let mut goal = target.eta();
+        let lookahead = self.config.lookahead;
+        if lookahead > 0.0 {
+            let prev = points[active - 1];
+            let seg = [target.x - prev.x, target.y - prev.y];
+            let len = seg[0].hypot(seg[1]);
+            if len > 0.0 {
+                let e = [seg[0] / len, seg[1] / len];
+                let along = ((ship[0] - prev.x) * e[0] + (ship[1] - prev.y) * e[1]).clamp(0.0, len);
+                let remaining = len - along;
+                if remaining >= lookahead {
+                    let s = along + lookahead;
+                    goal = [prev.x + s * e[0], prev.y + s * e[1], target.psi];
+                } else if active < last {
+                    let next = points[active + 1];
+                    let seg2 = [next.x - target.x, next.y - target.y];
+                    let len2 = seg2[0].hypot(seg2[1]);
+                    let s = (lookahead - remaining).min(len2);
+                    if len2 > 0.0 {
+                        goal = [
+                            target.x + s * seg2[0] / len2,
+                            target.y + s * seg2[1] / len2,
+                            next.psi,
+                        ];
+                    }
+                }
+            }
+        }
+        let (dx, dy) = (goal[0] - ship[0], goal[1] - ship[1]);
+        if self.config.los_distance > 0.0 && dx.hypot(dy) > self.config.los_distance {
+            goal[2] = dy.atan2(dx);
+        }
+        goal
     }
 
     /// The inner loop's parameters.
@@ -428,7 +482,12 @@ impl Controller {
     /// Copies the nearest obstacles (by range from the tow) into the MPC's list;
     /// returns how many.
     fn select_obstacles(&mut self, m: &Measurement) -> usize {
-        let slots = self.config.ship.clearance.max_obstacles.min(self.config.tug.clearance.max_obstacles);
+        let slots = self
+            .config
+            .ship
+            .clearance
+            .max_obstacles
+            .min(self.config.tug.clearance.max_obstacles);
         let points = [
             [m.ship[0], m.ship[1]],
             [m.tugs[0][0], m.tugs[0][1]],

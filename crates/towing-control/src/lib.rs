@@ -1,10 +1,10 @@
 //! The towing controller of Du, Negenborn, Reppa (2022), "COLREGS-compliant
 //! collision avoidance for physically coupled multi-vessel systems with
 //! distributed MPC", Ocean Engineering 260, 111917, without FFI: the ship
-//! reference system ([`towing_guidance`]), the distributed MPC (ADMM, Algorithm
-//! 1) or the centralized MPC (eq. (12)) of [`towing_mpc`], the fallback path and
-//! the tugs' inner stabilising loop. The FMU (`fmu-controller`) is a thin shell
-//! around [`Controller`].
+//! reference system ([`towing_guidance`]), the distributed MPC (ADMM,
+//! Algorithm 1) or the centralized MPC (eq. (12)) of [`towing_mpc`], the
+//! fallback path and the tugs' inner stabilising loop. The FMU
+//! (`fmu-controller`) is a thin shell around [`Controller`].
 //!
 //! ```no_run
 //! use towing_control::{Controller, ControllerConfig, Measurement};

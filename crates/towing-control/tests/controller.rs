@@ -1,0 +1,224 @@
+//! Controller behaviour on constructed measurements: refused inputs, obstacles
+//! on top of the tow, bounds, the hold and inner loop between samples.
+#![allow(clippy::unwrap_used)]
+
+use towing_control::{
+    AvoidanceScheme, Controller, ControllerConfig, Measurement, MeasurementError,
+};
+use towing_guidance::ObstacleInput;
+use towing_model::{Scenario, World};
+
+fn paper_measurement() -> (Scenario, Measurement) {
+    let scenario = Scenario::paper().unwrap();
+    let world = World::new(&scenario, scenario.world_config).unwrap();
+    let v =
+        |s: &towing_model::VesselState| [s.eta[0], s.eta[1], s.eta[2], s.nu[0], s.nu[1], s.nu[2]];
+    let mut m = Measurement {
+        ship: v(world.ship()),
+        tugs: [v(world.tug(0)), v(world.tug(1))],
+        ..Measurement::default()
+    };
+    for (k, slot) in m.obstacles.iter_mut().enumerate() {
+        let o = world.obstacle(k);
+        *slot = ObstacleInput {
+            x: o.x,
+            y: o.y,
+            psi: o.psi,
+            speed: o.speed,
+            length: o.length,
+            width: o.width,
+            kind: o.kind,
+        };
+    }
+    (scenario, m)
+}
+
+fn assert_within_bounds(c: &towing_control::Command, config: &ControllerConfig) {
+    for f in c.tension {
+        assert!(
+            f.is_finite()
+                && f >= config.ship.min_tension - 1e-9
+                && f <= config.ship.max_tension + 1e-9,
+            "tension {f}"
+        );
+    }
+    for tau in c.tug_thrust {
+        for (v, l) in tau.iter().zip(config.tug.thrust_limit) {
+            assert!(v.is_finite() && v.abs() <= l + 1e-9, "thrust {v} over {l}");
+        }
+    }
+}
+
+#[test]
+fn a_non_finite_input_is_refused_by_name_and_changes_nothing() {
+    let (scenario, m) = paper_measurement();
+    let mut c = Controller::new(ControllerConfig::new(scenario)).unwrap();
+    let names = ["x", "y", "psi", "u", "v", "r"];
+    for (vessel, pick) in [("ship", 0), ("tug1", 1), ("tug2", 2)] {
+        for (i, field) in names.iter().enumerate() {
+            let mut bad = m;
+            match pick {
+                0 => bad.ship[i] = f64::NAN,
+                n => bad.tugs[n - 1][i] = f64::INFINITY,
+            }
+            let err = c.sample(&bad).unwrap_err();
+            match &err {
+                MeasurementError::NonFinite { name, value } => {
+                    assert_eq!(name, &format!("{vessel}.{field}"));
+                    assert!(!value.is_finite());
+                }
+                other => panic!("unexpected {other}"),
+            }
+            assert!(
+                err.to_string().contains(&format!("{vessel}.{field}")),
+                "{err}"
+            );
+        }
+    }
+    let mut bad = m;
+    bad.obstacles[2].speed = f64::NAN;
+    let err = c.sample(&bad).unwrap_err();
+    assert!(err.to_string().contains("obstacle[3]"), "{err}");
+    // Nothing was applied: the first real sample starts from rest.
+    let f0 = ControllerConfig::new(Scenario::paper().unwrap())
+        .ship
+        .min_tension;
+    assert_eq!(c.applied().ship, [f0, f0, 0.0, 0.0]);
+    assert!(c.sample(&m).is_ok());
+}
+
+#[test]
+fn obstacles_on_top_of_the_tow_give_a_bounded_command_without_fallback_panics() {
+    let (scenario, mut m) = paper_measurement();
+    let config = ControllerConfig::new(scenario);
+    let mut c = Controller::new(config.clone()).unwrap();
+    // A static circle on the ship, a target ship on tug 2, another on tug 1.
+    m.obstacles[0] = ObstacleInput {
+        x: m.ship[0],
+        y: m.ship[1],
+        psi: 0.0,
+        speed: 0.0,
+        length: 1.0,
+        width: 1.0,
+        kind: 1,
+    };
+    m.obstacles[1] = ObstacleInput {
+        x: m.tugs[1][0],
+        y: m.tugs[1][1],
+        psi: 1.0,
+        speed: 0.07,
+        length: 1.48,
+        width: 0.48,
+        kind: 2,
+    };
+    m.obstacles[2] = ObstacleInput {
+        x: m.tugs[0][0],
+        y: m.tugs[0][1],
+        psi: -2.0,
+        speed: 0.07,
+        length: 1.48,
+        width: 0.48,
+        kind: 2,
+    };
+    for _ in 0..5 {
+        let r = c.sample(&m).unwrap();
+        assert_within_bounds(&r.command, &config);
+        assert!(r.guidance.d_ob < 1.0, "d_ob {}", r.guidance.d_ob);
+        let between = c.command_at(0.5, &m).unwrap();
+        assert_within_bounds(&between, &config);
+    }
+}
+
+#[test]
+fn rate_bounds_hold_from_sample_to_sample() {
+    let (scenario, m) = paper_measurement();
+    let config = ControllerConfig::new(scenario);
+    let mut c = Controller::new(config.clone()).unwrap();
+    // From the pretension the controller starts with.
+    let f0 = config.ship.min_tension;
+    assert_eq!(c.applied().ship, [f0, f0, 0.0, 0.0]);
+    let mut prev = [f0, f0, 0.0, 0.0];
+    for _ in 0..4 {
+        let r = c.sample(&m).unwrap();
+        let now = [
+            r.command.tension[0],
+            r.command.tension[1],
+            r.desired_angle[0],
+            r.desired_angle[1],
+        ];
+        for k in 0..2 {
+            assert!(
+                (now[k] - prev[k]).abs() <= config.ship.tension_rate + 1e-6,
+                "{now:?} {prev:?}"
+            );
+            assert!((now[2 + k] - prev[2 + k]).abs() <= config.ship.angle_rate + 1e-6);
+        }
+        prev = now;
+    }
+}
+
+#[test]
+fn scheme_three_tracks_the_unaltered_route_and_scheme_two_drops_the_distance_cost() {
+    let (scenario, mut m) = paper_measurement();
+    // A target ship head-on, 4 m ahead of the forward tug: the route is altered.
+    let psi = m.ship[2];
+    let ahead = 2.1 + 4.0;
+    m.obstacles[3] = ObstacleInput {
+        x: m.ship[0] + ahead * psi.cos(),
+        y: m.ship[1] + ahead * psi.sin(),
+        psi: psi + std::f64::consts::PI,
+        speed: 0.07,
+        length: 1.48,
+        width: 0.48,
+        kind: 2,
+    };
+    let run = |scheme| {
+        let mut config = ControllerConfig::new(scenario.clone());
+        config.scheme = scheme;
+        config.lookahead = 0.0;
+        config.los_distance = 0.0;
+        let mut c = Controller::new(config).unwrap();
+        c.sample(&m).unwrap()
+    };
+    let one = run(AvoidanceScheme::AlterAndCost);
+    let three = run(AvoidanceScheme::CostOnly);
+    assert!(one.guidance.altered && three.guidance.altered);
+    assert_eq!(one.reference, one.guidance.eta_sd.eta());
+    assert_eq!(three.reference, three.guidance.route_waypoint.eta());
+    assert_ne!(one.reference, three.reference);
+    assert_eq!(one.situation[3], 1, "head-on");
+    assert_eq!(one.role[3], 1, "give-way");
+}
+
+#[test]
+fn the_lookahead_point_lies_ahead_on_the_leg_and_the_heading_looks_at_it() {
+    let (scenario, m) = paper_measurement();
+    let mut c = Controller::new(ControllerConfig::new(scenario.clone())).unwrap();
+    let r = c.sample(&m).unwrap();
+    // At the origin, on the route: 3 m along the first leg (course 101.3 deg).
+    let course = (14.0f64 - 7.0).atan2(-6.3 + 4.9);
+    let expect = [-4.9 + 3.0 * course.cos(), 7.0 + 3.0 * course.sin()];
+    assert!(
+        (r.reference[0] - expect[0]).abs() < 1e-9 && (r.reference[1] - expect[1]).abs() < 1e-9,
+        "{:?}",
+        r.reference
+    );
+    assert!((r.reference[2] - course).abs() < 1e-9);
+}
+
+#[test]
+fn bad_configuration_values_are_named() {
+    let (scenario, _) = paper_measurement();
+    let mut config = ControllerConfig::new(scenario);
+    config.lookahead = -1.0;
+    let err = Controller::new(config.clone()).unwrap_err();
+    assert_eq!(err.name, "lookahead");
+    config.lookahead = 3.0;
+    config.admm.max_iterations = 0;
+    let err = Controller::new(config.clone()).unwrap_err();
+    assert_eq!(err.name, "max_iterations");
+    config.admm.max_iterations = 30;
+    config.inner.gain[1] = f64::NAN;
+    let err = Controller::new(config).unwrap_err();
+    assert_eq!(err.name, "inner_loop_gain_sway");
+}
