@@ -5,14 +5,19 @@
 //! ship: on the ship's centre line (the formation puts tug 2 inside the tug's
 //! clearance of it, so consensus is not reachable and the loop runs to S), and
 //! 1.5 m to starboard. Every timed sample starts cold ([`Admm::reset`]). The
-//! iteration counts are printed to stderr. Run with
+//! iteration counts are printed to stderr. The same samples, and one without the
+//! obstacle, with the centralized MPC of eq. (12) ([`Centralized`], SCP to
+//! convergence of the first move, cold each time). Run with
 //! `cargo bench -p towing-mpc --bench admm`.
 
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use towing_model::{HullModel, Scenario};
-use towing_mpc::{Admm, AdmmSettings, AppliedCommand, Obstacle, PredictionParams, SampleInput};
+use towing_mpc::{
+    Admm, AdmmSettings, AppliedCommand, Centralized, CentralizedSettings, Obstacle,
+    PredictionParams, SampleInput, ShipMpcParams, TugMpcParams,
+};
 
 fn bench(c: &mut Criterion) {
     let scenario = Scenario::paper().expect("paper scenario");
@@ -64,6 +69,48 @@ fn bench(c: &mut Criterion) {
             b.iter(|| {
                 admm.reset();
                 black_box(admm.solve_sample(black_box(&input)))
+            })
+        });
+    }
+    for (name, obstacles) in [
+        ("centralized_sample_free", &[][..]),
+        (
+            "centralized_sample_near_encounter_offset",
+            &[Obstacle::Circle {
+                centre: ahead(3.0, 1.5),
+                radius: 0.5,
+            }][..],
+        ),
+    ] {
+        let input = SampleInput {
+            ship,
+            tugs: [state(&scenario.tugs[0]), state(&scenario.tugs[1])],
+            previous: AppliedCommand::default(),
+            reference,
+            obstacles,
+        };
+        let mut central = Centralized::from_scenario(
+            &scenario,
+            HullModel::NonlinearDamping,
+            PredictionParams::default(),
+            ShipMpcParams::default(),
+            TugMpcParams::default(),
+            CentralizedSettings::default(),
+        )
+        .expect("centralized");
+        let report = central.solve_sample(&input);
+        eprintln!(
+            "{name}: {} SCP iterations, converged {}, failed {}, cost {}, consensus max {:e}",
+            report.iterations,
+            report.converged,
+            report.failed,
+            report.cost,
+            report.breakdown.consensus_max
+        );
+        c.bench_function(name, |b| {
+            b.iter(|| {
+                central.reset();
+                black_box(central.solve_sample(black_box(&input)))
             })
         });
     }

@@ -5,7 +5,8 @@
 //! programming, and one SCP step of each subproblem of the ADMM: the tug local
 //! problem (25) ([`TugMpc`]) and the coordination problem (26) ([`ShipMpc`]), on
 //! a thin Clarabel wrapper ([`Qp`]), and the ADMM loop of Algorithm 1 over them
-//! ([`Admm`], one control sample). The FMU is elsewhere.
+//! ([`Admm`], one control sample), and the centralized MPC of eq. (12) on the
+//! same models, costs and constraints ([`Centralized`]). The FMU is elsewhere.
 //!
 //! - [`ShipModel`]: the coordination controller's model, eq. (15) in the
 //!   consistent form of `paper/NOTES.md` (state `[x, y, psi, u, v, r]`, input
@@ -83,6 +84,7 @@
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
 pub mod admm;
+pub mod centralized;
 pub mod formation;
 pub mod hull;
 pub mod lines;
@@ -99,6 +101,7 @@ pub mod tug_mpc;
 pub use admm::{
     Admm, AdmmBuildError, AdmmReport, AdmmSettings, AppliedCommand, IterationRecord, SampleInput,
 };
+pub use centralized::{Centralized, CentralizedReport, CentralizedSettings, CostBreakdown};
 pub use formation::FormationMap;
 pub use hull::{JacobianMethod, PredictionHull};
 pub use lines::line_direction;

@@ -82,6 +82,35 @@ pub struct ScpReport {
     pub qp_iterations: u32,
 }
 
+impl ScpReport {
+    /// The report of a step whose QP gave `outcome`, with `costs = [before,
+    /// candidate, predicted decrease]` and the trust region's verdict.
+    pub(crate) fn judged(
+        outcome: QpOutcome,
+        costs: [f64; 3],
+        accepted: bool,
+        ratio: f64,
+        radius: f64,
+        qp_iterations: u32,
+    ) -> ScpReport {
+        let [cost_before, cost_candidate, predicted_decrease] = costs;
+        ScpReport {
+            qp: outcome,
+            accepted,
+            cost_before,
+            cost_after: if accepted {
+                cost_candidate
+            } else {
+                cost_before
+            },
+            predicted_decrease,
+            ratio,
+            radius,
+            qp_iterations,
+        }
+    }
+}
+
 /// The trust region (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrustRegion {
@@ -305,7 +334,7 @@ impl ClearanceParams {
 /// iterations (measured on the tug problem: 6 without the rows, 11 with them,
 /// 8 to 9 with the scale 100; 1e3 and 1e4 are worse again); scaled, the cost entry is
 /// `W / SLACK_SCALE`.
-const SLACK_SCALE: f64 = 100.0;
+pub(crate) const SLACK_SCALE: f64 = 100.0;
 
 /// The clearance rows of one subproblem: layout and the linearisation of the
 /// current step (buffers sized at construction). The row of sample `h` has entries
@@ -313,8 +342,10 @@ const SLACK_SCALE: f64 = 100.0;
 #[derive(Debug, Clone)]
 pub(crate) struct Clearance {
     params: ClearanceParams,
-    /// Number of increments (the slacks follow them in the QP's variables).
+    /// Number of increments (the first `n_u` variables of the QP).
     n_u: usize,
+    /// The QP variable of the first slack (`n_u` unless placed elsewhere).
+    first_slack: usize,
     /// Increments per sample.
     per_step: usize,
     horizon: usize,
@@ -349,13 +380,30 @@ impl Clearance {
         horizon: usize,
         first_extra_row: usize,
     ) -> Vec<(usize, usize)> {
-        let n_u = per_step * horizon;
+        Clearance::entries_at(
+            params,
+            per_step,
+            horizon,
+            first_extra_row,
+            per_step * horizon,
+        )
+    }
+
+    /// As [`Clearance::entries`] with the slacks from QP variable `first_slack`
+    /// (several clearance blocks in one QP).
+    pub fn entries_at(
+        params: &ClearanceParams,
+        per_step: usize,
+        horizon: usize,
+        first_extra_row: usize,
+        first_slack: usize,
+    ) -> Vec<(usize, usize)> {
         let mut out = Vec::new();
         for k in 0..Clearance::slacks(params, horizon) {
             for v in 0..Clearance::width(params, per_step, k) {
                 out.push((first_extra_row + k, v));
             }
-            out.push((first_extra_row + k, n_u + k));
+            out.push((first_extra_row + k, first_slack + k));
         }
         out
     }
@@ -369,6 +417,20 @@ impl Clearance {
         first_row: usize,
         slots: Vec<usize>,
     ) -> Clearance {
+        let n_u = per_step * horizon;
+        Clearance::new_at(params, per_step, horizon, first_row, slots, n_u)
+    }
+
+    /// As [`Clearance::new`] with the slacks from QP variable `first_slack`
+    /// (the layout of [`Clearance::entries_at`]).
+    pub fn new_at(
+        params: ClearanceParams,
+        per_step: usize,
+        horizon: usize,
+        first_row: usize,
+        slots: Vec<usize>,
+        first_slack: usize,
+    ) -> Clearance {
         let n = Clearance::slacks(&params, horizon);
         let mut offsets = Vec::with_capacity(n + 1);
         offsets.push(0);
@@ -379,6 +441,7 @@ impl Clearance {
         Clearance {
             params,
             n_u,
+            first_slack,
             per_step,
             horizon,
             first_row,
@@ -478,8 +541,8 @@ impl Clearance {
             } else {
                 0.0
             };
-            set_box(qp, self.n_u + k, 0.0, p.max_slack * SLACK_SCALE);
-            qp.q_mut()[self.n_u + k] = p.penalty / SLACK_SCALE;
+            set_box(qp, self.first_slack + k, 0.0, p.max_slack * SLACK_SCALE);
+            qp.q_mut()[self.first_slack + k] = p.penalty / SLACK_SCALE;
         }
     }
 
@@ -489,7 +552,7 @@ impl Clearance {
         let p = &self.params;
         (0..self.active.len())
             .filter(|&k| self.active[k])
-            .map(|k| p.penalty_at(self.dist[k]) - p.penalty / SLACK_SCALE * x[self.n_u + k])
+            .map(|k| p.penalty_at(self.dist[k]) - p.penalty / SLACK_SCALE * x[self.first_slack + k])
             .sum()
     }
 }

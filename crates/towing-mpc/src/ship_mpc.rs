@@ -58,6 +58,9 @@ const RATE_ROWS: usize = 2 * 4 * (HORIZON - 1);
 pub struct ShipMpcParams {
     /// `w_S = (w_S1, w_S2, w_S3)`: pose error, velocity, distance (Table 3: 1, 75, 1).
     pub weights: [f64; 3],
+    /// Weight of the yaw rate in the velocity term (s^2/rad^2); `None` uses
+    /// `w_S2` as eq. (13) does for all three components of `nu`.
+    pub yaw_rate_weight: Option<f64>,
     /// `F_min` (N), eq. (18), where the paper has 0: a pretension keeping both
     /// lines taut. With slack lines the formation (eq. (4)-(6)) no longer fixes
     /// the tugs, the towing angles drift with them, and the next pull starts
@@ -97,6 +100,7 @@ impl Default for ShipMpcParams {
     fn default() -> Self {
         ShipMpcParams {
             weights: [1.0, 75.0, 1.0],
+            yaw_rate_weight: None,
             min_tension: 0.1,
             max_tension: 3.0,
             max_angle: 30f64.to_radians(),
@@ -412,20 +416,14 @@ impl ShipMpc {
             self.plan = self.candidate;
             self.states = self.candidate_states;
         }
-        ScpReport {
-            qp: outcome,
+        ScpReport::judged(
+            outcome,
+            [cost_before, cost_candidate, predicted],
             accepted,
-            cost_before,
-            cost_after: if accepted {
-                cost_candidate
-            } else {
-                cost_before
-            },
-            predicted_decrease: predicted,
             ratio,
-            radius: self.trust.radius(),
-            qp_iterations: iterations,
-        }
+            self.trust.radius(),
+            iterations,
+        )
     }
 }
 
@@ -460,7 +458,12 @@ fn accumulate(
         let err = [x[0] - r[0], x[1] - r[1], angle_difference(x[2], r[2])];
         for c in 0..3 {
             quad.residual(err[c], w1, 0.0, &rows[c]);
-            quad.residual(x[3 + c], w2, 0.0, &rows[3 + c]);
+            let wv = if c == 2 {
+                params.yaw_rate_weight.unwrap_or(w2)
+            } else {
+                w2
+            };
+            quad.residual(x[3 + c], wv, 0.0, &rows[3 + c]);
         }
         for (k, w) in [
             (0, params.tension_weight),

@@ -305,20 +305,14 @@ impl TugMpc {
             self.plan = self.candidate;
             self.states = self.candidate_states;
         }
-        ScpReport {
-            qp: outcome,
+        ScpReport::judged(
+            outcome,
+            [cost_before, cost_candidate, predicted],
             accepted,
-            cost_before,
-            cost_after: if accepted {
-                cost_candidate
-            } else {
-                cost_before
-            },
-            predicted_decrease: predicted,
             ratio,
-            radius: self.trust.radius(),
-            qp_iterations: iterations,
-        }
+            self.trust.radius(),
+            iterations,
+        )
     }
 }
 

@@ -269,14 +269,14 @@ fn check_bounds(a: &Admm, r: &AdmmReport, previous: &AppliedCommand) {
     let tol = 1e-9;
     let mut before = previous.ship;
     for k in 0..2 {
-        before[k] = before[k].clamp(0.0, sp.max_tension);
+        before[k] = before[k].clamp(sp.min_tension, sp.max_tension);
         before[2 + k] = before[2 + k].clamp(-sp.max_angle, sp.max_angle);
     }
     let first = [r.tension[0], r.tension[1], r.angle[0], r.angle[1]];
     assert_eq!(first, a.ship().plan()[0]);
     for u in a.ship().plan() {
         for k in 0..2 {
-            assert!(u[k] >= -tol && u[k] <= sp.max_tension + tol, "{u:?}");
+            assert!(u[k] >= sp.min_tension - tol && u[k] <= sp.max_tension + tol, "{u:?}");
             assert!(
                 (u[k] - before[k]).abs() <= sp.tension_rate + tol,
                 "{u:?} {before:?}"
