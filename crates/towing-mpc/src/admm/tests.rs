@@ -276,7 +276,10 @@ fn check_bounds(a: &Admm, r: &AdmmReport, previous: &AppliedCommand) {
     assert_eq!(first, a.ship().plan()[0]);
     for u in a.ship().plan() {
         for k in 0..2 {
-            assert!(u[k] >= sp.min_tension - tol && u[k] <= sp.max_tension + tol, "{u:?}");
+            assert!(
+                u[k] >= sp.min_tension - tol && u[k] <= sp.max_tension + tol,
+                "{u:?}"
+            );
             assert!(
                 (u[k] - before[k]).abs() <= sp.tension_rate + tol,
                 "{u:?} {before:?}"
