@@ -80,6 +80,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(v) = env("W_T2") {
         config.tug.weights[1] = v;
     }
+    if let Some(v) = env("W_R") {
+        config.ship.yaw_rate_weight = Some(v);
+    }
+    if let Some(v) = env("ARCH") {
+        config.architecture = towing_control::Architecture::from_code(v as i32)?;
+    }
     let mut controller = Controller::new(config)?;
     let mut csv = match args.get(3) {
         Some(path) => Some(std::io::BufWriter::new(std::fs::File::create(path)?)),
@@ -92,6 +98,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut iters = Vec::new();
     let mut not_converged = 0;
     let mut min_clear = f64::INFINITY;
+    let dest = scenario.route.destination;
+    let mut settled_since: Option<f64> = None;
     let wall = std::time::Instant::now();
     for n in 0..steps {
         let m = measure(&world);
@@ -168,6 +176,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 c.tension[1]
             )?;
         }
+        {
+            let s = world.ship();
+            let ok = (s.eta[0] - dest.x).hypot(s.eta[1] - dest.y)
+                <= 0.5 * scenario.ship_data.length
+                && towing_model::wrap_angle(s.eta[2] - dest.psi).abs() <= 3f64.to_radians()
+                && s.nu[0].abs() < 0.01
+                && s.nu[1].abs() < 0.01
+                && s.nu[2].abs() < 0.01;
+            if !ok {
+                settled_since = None;
+            } else if settled_since.is_none() {
+                settled_since = Some(world.time());
+            }
+        }
         // Clearance to every active obstacle (centre distance minus radius, crude).
         for k in 0..towing_model::MAX_OBSTACLES {
             let o = world.obstacle(k);
@@ -184,11 +206,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     iters.sort_unstable();
     let s = world.ship();
     println!(
-        "end t={:.0}: ship at ({:.2}, {:.2}) psi {:.1} deg, u {:.3}; wall {:.2} s; sample ms median {:.2} p99 {:.2} max {:.2}; iterations median {} p99 {} max {}; not converged {}; fallbacks {}; min crude clearance {:.2} m",
+        "end t={:.0}: ship at ({:.2}, {:.2}) psi {:.1} deg, u {:.3}; wall {:.2} s; sample ms median {:.2} p99 {:.2} max {:.2}; iterations median {} p99 {} max {}; not converged {}; fallbacks {}; min crude clearance {:.2} m; settled at {:?}",
         world.time(), s.eta[0], s.eta[1], s.eta[2].to_degrees(), s.nu[0], wall.elapsed().as_secs_f64(),
         times[times.len() / 2], times[times.len() * 99 / 100], times[times.len() - 1],
         iters[iters.len() / 2], iters[iters.len() * 99 / 100], iters[iters.len() - 1], not_converged,
-        controller.fallbacks(), min_clear
+        controller.fallbacks(), min_clear, settled_since
     );
     Ok(())
 }

@@ -3,7 +3,9 @@
 
 use towing_guidance::{GuidanceParams, GuidanceSettings, Route};
 use towing_model::{HullModel, Scenario};
-use towing_mpc::{AdmmSettings, PredictionParams, ShipMpcParams, TugMpcParams};
+use towing_mpc::{
+    AdmmSettings, CentralizedSettings, PredictionParams, ShipMpcParams, TugMpcParams,
+};
 
 use crate::error::ConfigError;
 
@@ -138,6 +140,8 @@ pub struct ControllerConfig {
     pub prediction: PredictionParams,
     /// ADMM penalty, iterations, tolerances.
     pub admm: AdmmSettings,
+    /// The centralized problem's SCP loop.
+    pub centralized: CentralizedSettings,
     /// Coordination problem (Table 3 weights, bounds, rate bounds).
     pub ship: ShipMpcParams,
     /// Tug problems (Table 3 weights, thrust bounds).
@@ -180,6 +184,7 @@ impl ControllerConfig {
             scheme: AvoidanceScheme::default(),
             prediction: PredictionParams::default(),
             admm: AdmmSettings::default(),
+            centralized: CentralizedSettings::default(),
             ship: ShipMpcParams::default(),
             tug: TugMpcParams::default(),
             guidance,

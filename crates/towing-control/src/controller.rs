@@ -30,10 +30,11 @@ use towing_guidance::{
 };
 use towing_model::{VesselData, MAX_OBSTACLES};
 use towing_mpc::{
-    Admm, AppliedCommand, Obstacle, SampleInput, ShipInput, ShipModel, TugInput, HORIZON,
+    Admm, AppliedCommand, Centralized, Obstacle, SampleInput, ShipInput, ShipModel, ShipState,
+    TugInput, TugState, HORIZON,
 };
 
-use crate::config::{ControllerConfig, InnerLoopParams};
+use crate::config::{Architecture, ControllerConfig, InnerLoopParams};
 use crate::error::{ConfigError, MeasurementError};
 
 /// What the controller reads every step: the plant's outputs.
@@ -144,7 +145,7 @@ pub struct SampleReport {
 pub struct Controller {
     config: ControllerConfig,
     guidance: ReferenceSystem,
-    admm: Admm,
+    solver: Solver,
     inner_k: [[[f64; 3]; 3]; 2],
     thrust_limit: [[f64; 3]; 2],
     applied: AppliedCommand,
@@ -188,7 +189,22 @@ impl Controller {
             ship_params.weights[2] = 0.0;
             tug_params.weights[2] = 0.0;
         }
-        let admm = build_admm(&config, ship_params, tug_params)?;
+        let solver = match config.architecture {
+            Architecture::Distributed => {
+                Solver::Distributed(build_admm(&config, ship_params, tug_params)?)
+            }
+            Architecture::Centralized => Solver::Centralized(Box::new(
+                Centralized::from_scenario(
+                    &config.scenario,
+                    config.hull,
+                    config.prediction,
+                    ship_params,
+                    tug_params,
+                    config.centralized,
+                )
+                .map_err(|e| ConfigError::new("centralized MPC", format!("{e:?}")))?,
+            )),
+        };
         let s = &config.scenario;
         let inner_k = std::array::from_fn(|i| {
             let m = mass_matrix(&s.tug_data[i]);
@@ -207,7 +223,7 @@ impl Controller {
         Ok(Controller {
             config,
             guidance,
-            admm,
+            solver,
             inner_k,
             thrust_limit,
             // The lines start at their pretension (`min_tension`), straight.
@@ -288,12 +304,12 @@ impl Controller {
             reference: [reference; HORIZON],
             obstacles: &self.mpc_obstacles[..n_obstacles],
         };
-        let report = self.admm.solve_sample(&input);
-        let ship_plan = *self.admm.ship().plan();
-        let tug_plans = [*self.admm.tug(0).plan(), *self.admm.tug(1).plan()];
+        let report = self.solver.solve(&input);
+        let ship_plan = *self.solver.ship_plan();
+        let tug_plans = [*self.solver.tug_plan(0), *self.solver.tug_plan(1)];
         let finite = ship_plan.iter().flatten().all(|v| v.is_finite())
             && tug_plans.iter().flatten().flatten().all(|v| v.is_finite());
-        let fallback = if report.last_step_failed() {
+        let fallback = if report.failed {
             Some("a subproblem's last QP solve failed")
         } else if !finite {
             Some("the plan is not finite")
@@ -303,7 +319,7 @@ impl Controller {
         let (ship_cmd, tug_cmd) = if fallback.is_some() {
             self.fallbacks += 1;
             let (s, t) = self.fallback_command();
-            self.admm.reset();
+            self.solver.reset();
             (s, t)
         } else {
             (ship_plan[0], [tug_plans[0][0], tug_plans[1][0]])
@@ -315,7 +331,7 @@ impl Controller {
             self.spare_tugs =
                 std::array::from_fn(|i| std::array::from_fn(|h| tug_plans[i][shift(h)]));
             self.have_spare = true;
-            self.admm.shift();
+            self.solver.shift();
         } else {
             let shift = |h: usize| (h + 1).min(HORIZON - 1);
             self.spare_ship = std::array::from_fn(|h| self.spare_ship[shift(h)]);
@@ -517,12 +533,12 @@ impl Controller {
     fn prediction(&self, m: &Measurement, from_plan: bool) -> Prediction {
         let mut out = Prediction::default();
         if from_plan {
-            out.ship = *self.admm.ship().predicted_states();
+            out.ship = *self.solver.ship_predicted();
             for i in 0..2 {
-                out.tugs[i] = *self.admm.tug(i).predicted_states();
+                out.tugs[i] = *self.solver.tug_predicted(i);
             }
         } else {
-            let model: &ShipModel = self.admm.ship().model();
+            let model: &ShipModel = self.solver.ship_model();
             out.ship = model.rollout::<HORIZON>(&m.ship, &[self.applied.ship; HORIZON]);
             for i in 0..2 {
                 out.tugs[i] = [m.tugs[i]; HORIZON];
@@ -554,6 +570,99 @@ fn mpc_obstacle(o: &ObstacleInput) -> Obstacle {
             semi_major: 0.5 * o.length,
             semi_minor: 0.5 * o.width.min(o.length),
             orientation: o.psi,
+        }
+    }
+}
+
+/// Common report of either architecture.
+struct SolveReport {
+    iterations: usize,
+    converged: bool,
+    failed: bool,
+    r_pri: [f64; 2],
+    r_dual: [f64; 2],
+}
+
+/// The distributed or the centralized MPC.
+#[derive(Debug)]
+enum Solver {
+    Distributed(Admm),
+    Centralized(Box<Centralized>),
+}
+
+impl Solver {
+    fn solve(&mut self, input: &SampleInput<'_>) -> SolveReport {
+        match self {
+            Solver::Distributed(a) => {
+                let r = a.solve_sample(input);
+                SolveReport {
+                    iterations: r.iterations,
+                    converged: r.converged,
+                    failed: r.last_step_failed(),
+                    r_pri: r.r_pri,
+                    r_dual: r.r_dual,
+                }
+            }
+            Solver::Centralized(c) => {
+                let r = c.solve_sample(input);
+                SolveReport {
+                    iterations: r.iterations,
+                    converged: r.converged,
+                    failed: r.failed,
+                    // The consensus violation plays the primal residual's part.
+                    r_pri: [r.breakdown.consensus_max; 2],
+                    r_dual: [0.0; 2],
+                }
+            }
+        }
+    }
+
+    fn ship_plan(&self) -> &[ShipInput; HORIZON] {
+        match self {
+            Solver::Distributed(a) => a.ship().plan(),
+            Solver::Centralized(c) => c.ship_plan(),
+        }
+    }
+
+    fn tug_plan(&self, i: usize) -> &[TugInput; HORIZON] {
+        match self {
+            Solver::Distributed(a) => a.tug(i).plan(),
+            Solver::Centralized(c) => c.tug_plan(i),
+        }
+    }
+
+    fn ship_predicted(&self) -> &[ShipState; HORIZON] {
+        match self {
+            Solver::Distributed(a) => a.ship().predicted_states(),
+            Solver::Centralized(c) => c.ship_predicted(),
+        }
+    }
+
+    fn tug_predicted(&self, i: usize) -> &[TugState; HORIZON] {
+        match self {
+            Solver::Distributed(a) => a.tug(i).predicted_states(),
+            Solver::Centralized(c) => c.tug_predicted(i),
+        }
+    }
+
+    fn ship_model(&self) -> &ShipModel {
+        match self {
+            Solver::Distributed(a) => a.ship().model(),
+            Solver::Centralized(c) => c.ship_model(),
+        }
+    }
+
+    fn reset(&mut self) {
+        match self {
+            Solver::Distributed(a) => a.reset(),
+            Solver::Centralized(c) => c.reset(),
+        }
+    }
+
+    fn shift(&mut self) {
+        match self {
+            Solver::Distributed(a) => a.shift(),
+            Solver::Centralized(c) => c.shift(),
         }
     }
 }

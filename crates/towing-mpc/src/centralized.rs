@@ -655,6 +655,12 @@ impl Centralized {
         )
     }
 
+    /// The ship's prediction model.
+    #[must_use]
+    pub fn ship_model(&self) -> &ShipModel {
+        &self.problem.ship
+    }
+
     /// The settings.
     #[must_use]
     pub fn settings(&self) -> &CentralizedSettings {
