@@ -191,7 +191,7 @@ impl Controller {
         }
         let solver = match config.architecture {
             Architecture::Distributed => {
-                Solver::Distributed(build_admm(&config, ship_params, tug_params)?)
+                Solver::Distributed(Box::new(build_admm(&config, ship_params, tug_params)?))
             }
             Architecture::Centralized => Solver::Centralized(Box::new(
                 Centralized::from_scenario(
@@ -586,7 +586,7 @@ struct SolveReport {
 /// The distributed or the centralized MPC.
 #[derive(Debug)]
 enum Solver {
-    Distributed(Admm),
+    Distributed(Box<Admm>),
     Centralized(Box<Centralized>),
 }
 
