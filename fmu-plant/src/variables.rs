@@ -435,5 +435,7 @@ fn build() -> ModelDescription {
             step_size: 0.1,
         },
         variables: v,
+        can_get_and_set_fmu_state: true,
+        can_serialize_fmu_state: true,
     }
 }

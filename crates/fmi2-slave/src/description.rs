@@ -54,6 +54,14 @@ pub struct ModelDescription {
     pub default_experiment: DefaultExperiment,
     /// `ModelVariables` in order: the variable at position `i` has `index = i + 1`.
     pub variables: Vec<Variable>,
+    /// `CoSimulation/@canGetAndSetFMUstate`. When false, `fmi2GetFMUstate`,
+    /// `fmi2SetFMUstate` and the serialization functions return `fmi2Error` with a
+    /// log line, without touching the model (its `Clone` is then never used).
+    pub can_get_and_set_fmu_state: bool,
+    /// `CoSimulation/@canSerializeFMUstate` (only meaningful with
+    /// `can_get_and_set_fmu_state`). When false, the serialization functions
+    /// return `fmi2Error` with a log line.
+    pub can_serialize_fmu_state: bool,
 }
 
 /// `UnitDefinitions/Unit` (FMI 2.0 section 2.2.2).
@@ -956,6 +964,14 @@ fn initial_allowed(causality: Causality, variability: Variability, initial: Init
     }
 }
 
+fn bool_text(b: bool) -> &'static str {
+    if b {
+        "true"
+    } else {
+        "false"
+    }
+}
+
 impl ModelDescription {
     /// The complete `modelDescription.xml`, including [`guid`](Self::guid).
     pub fn to_xml(&self) -> String {
@@ -1521,8 +1537,14 @@ impl ModelDescription {
             ("canRunAsynchronuously", "false"),
             ("canBeInstantiatedOnlyOncePerProcess", "false"),
             ("canNotUseMemoryManagementFunctions", "true"),
-            ("canGetAndSetFMUstate", "true"),
-            ("canSerializeFMUstate", "true"),
+            (
+                "canGetAndSetFMUstate",
+                bool_text(self.can_get_and_set_fmu_state),
+            ),
+            (
+                "canSerializeFMUstate",
+                bool_text(self.can_serialize_fmu_state && self.can_get_and_set_fmu_state),
+            ),
             ("providesDirectionalDerivative", "false"),
         ] {
             attr(&mut x, name, value);

@@ -168,6 +168,8 @@ mod tests {
                 Variable::real_parameter("a|b", 1, "", 0.5, Variability::Fixed, "x < y"),
                 Variable::real_input("psi", 2, "rad", 0.0, "heading").with_declared_type("Angle"),
             ],
+            can_get_and_set_fmu_state: true,
+            can_serialize_fmu_state: true,
         }
     }
 

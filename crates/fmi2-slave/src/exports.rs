@@ -921,6 +921,25 @@ pub unsafe fn set_string<M: Fmi2Model>(
     }
 }
 
+/// Refuses the FMU-state functions the model description does not declare
+/// (`canGetAndSetFMUstate`, `canSerializeFMUstate`).
+fn require_state_capability<M: Fmi2Model>(serialize: bool) -> Result<(), String> {
+    let d = M::description();
+    if !d.can_get_and_set_fmu_state {
+        return Err(format!(
+            "{} declares canGetAndSetFMUstate=\"false\"",
+            d.model_identifier
+        ));
+    }
+    if serialize && !d.can_serialize_fmu_state {
+        return Err(format!(
+            "{} declares canSerializeFMUstate=\"false\"",
+            d.model_identifier
+        ));
+    }
+    Ok(())
+}
+
 /// `fmi2GetFMUstate` (FMI 2.0 section 2.1.8): a deep copy of the model and the layer state
 /// (call state, clock, start/stop time). A non-NULL `*FMUstate` is overwritten in place.
 pub unsafe fn get_fmu_state<M: Fmi2Model>(
@@ -930,6 +949,7 @@ pub unsafe fn get_fmu_state<M: Fmi2Model>(
     // SAFETY: forwarded FMI contract.
     unsafe {
         guard::<M, _>(c, Func::GetFmuState, |inst| {
+            require_state_capability::<M>(false)?;
             let slot = out_ref(fmu_state, "FMUstate")?;
             if slot.is_null() {
                 let b = Box::new(StateBox {
@@ -955,6 +975,7 @@ pub unsafe fn set_fmu_state<M: Fmi2Model>(c: Fmi2Component, fmu_state: Fmi2FmuSt
     // SAFETY: forwarded FMI contract.
     unsafe {
         guard::<M, _>(c, Func::SetFmuState, |inst| {
+            require_state_capability::<M>(false)?;
             let b = state_box_mut::<M>(fmu_state)?;
             inst.model.clone_from(&b.model);
             inst.layer = b.layer;
@@ -995,6 +1016,7 @@ pub unsafe fn serialized_fmu_state_size<M: Fmi2Model>(
     // SAFETY: forwarded FMI contract.
     unsafe {
         guard::<M, _>(c, Func::SerializedFmuStateSize, |inst| {
+            require_state_capability::<M>(true)?;
             let b = state_box_mut::<M>(fmu_state)?;
             let size = out_ref(size, "size")?;
             if b.serialized.is_none() {
@@ -1019,6 +1041,7 @@ pub unsafe fn serialize_fmu_state<M: Fmi2Model>(
     // SAFETY: forwarded FMI contract.
     unsafe {
         guard::<M, _>(c, Func::SerializeFmuState, |inst| {
+            require_state_capability::<M>(true)?;
             let b = state_box_mut::<M>(fmu_state)?;
             if b.serialized.is_none() {
                 let mut out = Vec::new();
@@ -1051,6 +1074,7 @@ pub unsafe fn de_serialize_fmu_state<M: Fmi2Model>(
     // SAFETY: forwarded FMI contract.
     unsafe {
         guard::<M, _>(c, Func::DeSerializeFmuState, |inst| {
+            require_state_capability::<M>(true)?;
             let slot = out_ref(fmu_state, "FMUstate")?;
             let existing = if slot.is_null() {
                 None

@@ -452,6 +452,13 @@ impl Fmu {
         t
     }
 
+    /// `fmi2GetFMUstate` into a new state: the status and the handle (NULL on failure).
+    pub fn try_get_state(&self) -> (Fmi2Status, Fmi2FmuState) {
+        let mut s: Fmi2FmuState = ptr::null_mut();
+        let status = unsafe { (self.exports.get_fmu_state)(self.c, &mut s) };
+        (status, s)
+    }
+
     /// `fmi2GetFMUstate` into a new state, expected OK.
     pub fn get_state(&self) -> Fmi2FmuState {
         let mut s: Fmi2FmuState = ptr::null_mut();

@@ -66,6 +66,8 @@ fn sample() -> ModelDescription {
             Variable::integer_input("mode", 5, 0, "mode"),
             Variable::boolean_input("go", 6, false, "go"),
         ],
+        can_get_and_set_fmu_state: true,
+        can_serialize_fmu_state: true,
     }
 }
 

@@ -118,6 +118,8 @@ pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(|| {
             Variable::boolean_input("panic_now", B_PANIC_NOW, false, "panics when set to true"),
             Variable::string_parameter("label", S_LABEL, "lag", "free text"),
         ],
+        can_get_and_set_fmu_state: true,
+        can_serialize_fmu_state: true,
     }
 });
 

@@ -1,0 +1,367 @@
+//! TowingController through its exported FMI functions, in-process, as a master calls them:
+//! commands within bounds, NaN inputs, bad parameters, sample timing independent of the
+//! communication step, obstacles on top of the ship, refused measurements and the FMU-state
+//! functions it does not support.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
+
+mod support;
+
+use fmi2_slave::ffi::Fmi2Status;
+use fmi2_slave::{Causality, ValueType, VariableKind};
+use support::*;
+use towing_controller::variables::{self as vars, DESCRIPTION, NO_OBSTACLE_DISTANCE};
+
+fn var(name: &str) -> u32 {
+    DESCRIPTION
+        .variables
+        .iter()
+        .find(|v| v.name == name)
+        .unwrap_or_else(|| panic!("no variable {name}"))
+        .value_reference
+}
+
+/// Steps `n` times by `h` from `t0`, asserting Ok; returns the end time.
+fn steps(fmu: &fmi2_slave::testing::Fmu, t0: f64, h: f64, n: usize) -> f64 {
+    let mut t = t0;
+    for _ in 0..n {
+        assert_eq!(fmu.step(t, h), Fmi2Status::Ok, "{}", fmu.log_text());
+        t += h;
+    }
+    t
+}
+
+#[test]
+fn paper_inputs_give_finite_commands_within_bounds() {
+    let fmu = initialized("paper");
+    let mut t = 0.0;
+    for _ in 0..20 {
+        assert_eq!(fmu.step(t, 0.1), Fmi2Status::Ok, "{}", fmu.log_text());
+        t += 0.1;
+        assert_commands_within_bounds(&fmu);
+    }
+    // The ship starts at rest and the route leads away: the MPC pulls.
+    let v = commands(&fmu);
+    assert!(v[6] > 0.0 || v[7] > 0.0, "no tension commanded: {v:?}");
+    assert_eq!(fmu.get_integer(vars::SAMPLES), 2);
+    assert!(fmu.get_integer(vars::ADMM_ITERATIONS) >= 1);
+    assert_eq!(fmu.get_integer(vars::FALLBACKS), 0);
+    assert!(fmu.get_integer(vars::ACTIVE_WAYPOINT) >= 1);
+    // No obstacles: d_ob is the documented large finite number, no situations.
+    assert_eq!(fmu.get_real(vars::D_OB), NO_OBSTACLE_DISTANCE);
+    for slot in 0..8 {
+        assert_eq!(fmu.get_integer(vars::colregs_situation(slot)), -1);
+        assert_eq!(fmu.get_integer(vars::colregs_role(slot)), 0);
+    }
+    let compute_time = fmu.get_real(vars::COMPUTE_TIME);
+    assert!(compute_time > 0.0 && compute_time.is_finite());
+    for c in 0..3 {
+        assert!(fmu.get_real(vars::reference(c)).is_finite());
+    }
+    // The plan's predicted ship positions are near the ship (it moves < 1 m in 3 s).
+    let ship = paper_states()[0];
+    for h in 0..3 {
+        let x = fmu.get_real(vars::prediction(h, 0, 0));
+        let y = fmu.get_real(vars::prediction(h, 0, 1));
+        assert!(
+            (x - ship[0]).hypot(y - ship[1]) < 1.0,
+            "h = {h}: ({x}, {y})"
+        );
+    }
+}
+
+#[test]
+fn outputs_hold_their_start_values_until_the_first_step() {
+    let fmu = initialized("start");
+    let mut checked = 0;
+    for v in DESCRIPTION
+        .variables
+        .iter()
+        .filter(|v| v.causality == Causality::Output)
+    {
+        let vr = v.value_reference;
+        match &v.kind {
+            VariableKind::Real { start, .. } => {
+                assert_eq!(fmu.get_real(vr), start.unwrap(), "{}", v.name);
+            }
+            VariableKind::Integer { start, .. } => {
+                assert_eq!(fmu.get_integer(vr), start.unwrap(), "{}", v.name);
+            }
+            VariableKind::Boolean { start } => {
+                assert_eq!(fmu.get_boolean(vr), start.unwrap(), "{}", v.name);
+            }
+            VariableKind::String { .. } => panic!("String output {}", v.name),
+        }
+        checked += 1;
+    }
+    // 8 commands, 17 diagnostics, 8 x 2 COLREGS, 3 x 3 x 2 predictions.
+    assert_eq!(checked, 8 + 17 + 16 + 18);
+}
+
+#[test]
+fn non_finite_real_inputs_are_refused_naming_the_variable() {
+    let inputs: Vec<_> = DESCRIPTION
+        .variables
+        .iter()
+        .filter(|v| v.causality == Causality::Input && v.value_type() == ValueType::Real)
+        .collect();
+    // 3 vessels x 6, 2 towlines x 3, 8 obstacle slots x 6.
+    assert_eq!(inputs.len(), 18 + 6 + 48);
+    for (i, v) in inputs.iter().enumerate() {
+        let fmu = controller("nan");
+        let vr = v.value_reference;
+        assert_eq!(fmu.set_real(vr, 1.25), Fmi2Status::Ok);
+        let bad = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY][i % 3];
+        assert_eq!(fmu.set_real(vr, bad), Fmi2Status::Error, "{}", v.name);
+        let text = fmu.log_text();
+        assert!(
+            text.contains(&format!("'{}'", v.name)) && text.contains("not finite"),
+            "{}: {text}",
+            v.name
+        );
+        assert_eq!(fmu.get_real(vr), 1.25, "{} changed", v.name);
+    }
+}
+
+/// Sets one parameter on an instance; the status.
+type SetParameter = Box<dyn Fn(&fmi2_slave::testing::Fmu) -> Fmi2Status>;
+
+#[test]
+fn bad_parameters_are_refused_at_exit_initialization_naming_them() {
+    let cases: [(&str, SetParameter); 7] = [
+        (
+            "architecture",
+            Box::new(|f| f.set_integer(var("architecture"), 7)),
+        ),
+        (
+            "avoidance_scheme",
+            Box::new(|f| f.set_integer(var("avoidance_scheme"), 0)),
+        ),
+        (
+            "sample_time",
+            Box::new(|f| f.set_real(var("sample_time"), -1.0)),
+        ),
+        (
+            "log_file",
+            Box::new(|f| f.set_string(var("log_file"), "run.mcap")),
+        ),
+        (
+            "hull_model",
+            Box::new(|f| f.set_integer(var("hull_model"), 3)),
+        ),
+        (
+            "max_iterations",
+            Box::new(|f| f.set_integer(var("max_iterations"), 0)),
+        ),
+        ("rho", Box::new(|f| f.set_real(var("rho"), -0.5))),
+    ];
+    for (name, set) in &cases {
+        let fmu = controller(name);
+        set_states(&fmu, &paper_states());
+        assert_eq!(set(&fmu), Fmi2Status::Ok, "{name}: {}", fmu.log_text());
+        assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
+        assert_eq!(fmu.enter_init(), Fmi2Status::Ok, "{}", fmu.log_text());
+        assert_eq!(fmu.exit_init(), Fmi2Status::Error, "{name} was accepted");
+        let text = fmu.last_text();
+        assert!(text.contains(&format!("`{name}`")), "{name}: {text}");
+        // No controller: stepping is refused, not a crash.
+        assert_ne!(fmu.step(0.0, 0.1), Fmi2Status::Ok);
+    }
+}
+
+#[test]
+fn a_valid_non_default_parameter_set_is_accepted() {
+    let fmu = controller("params");
+    set_states(&fmu, &paper_states());
+    assert_eq!(fmu.set_integer(var("architecture"), 1), Fmi2Status::Ok);
+    assert_eq!(fmu.set_integer(var("avoidance_scheme"), 3), Fmi2Status::Ok);
+    assert_eq!(fmu.set_integer(var("hull_model"), 1), Fmi2Status::Ok);
+    assert_eq!(fmu.set_real(var("max_tension"), 2.0), Fmi2Status::Ok);
+    assert_eq!(
+        fmu.set_real(var("waterway_half_width"), 4.0),
+        Fmi2Status::Ok
+    );
+    fmu.init(0.0, None);
+    steps(&fmu, 0.0, 0.5, 2);
+    let v = commands(&fmu);
+    assert!(v[6] <= 2.0 + 1e-9 && v[7] <= 2.0 + 1e-9, "{v:?}");
+}
+
+#[test]
+fn without_resources_and_scenario_initialization_is_refused_with_a_reason() {
+    let fmu =
+        fmi2_slave::testing::Fmu::try_new(exports(), &DESCRIPTION, "bare", None, false).unwrap();
+    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
+    assert_eq!(fmu.enter_init(), Fmi2Status::Error);
+    assert!(
+        fmu.last_text().contains("set scenario"),
+        "{}",
+        fmu.log_text()
+    );
+}
+
+#[test]
+fn a_missing_scenario_file_is_named() {
+    let fmu = controller("missing");
+    assert_eq!(
+        fmu.set_string(vars::SCENARIO, "/nonexistent/route.toml"),
+        Fmi2Status::Ok
+    );
+    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
+    assert_eq!(fmu.enter_init(), Fmi2Status::Error);
+    assert!(
+        fmu.last_text().contains("/nonexistent/route.toml"),
+        "{}",
+        fmu.log_text()
+    );
+}
+
+/// With h = 0.1 and T_s = 1 s the tensions hold over the 10 steps of a sample and the
+/// counter counts samples, not steps.
+#[test]
+fn outputs_hold_between_samples_and_the_counter_counts_samples() {
+    let fmu = initialized("hold");
+    let mut t = 0.0;
+    let mut tensions = Vec::new();
+    for k in 0..20 {
+        assert_eq!(fmu.step(t, 0.1), Fmi2Status::Ok, "{}", fmu.log_text());
+        t += 0.1;
+        let expected_samples = if k < 10 { 1 } else { 2 };
+        assert_eq!(
+            fmu.get_integer(vars::SAMPLES),
+            expected_samples,
+            "after step {k}"
+        );
+        tensions.push([
+            fmu.get_real(vars::tension_cmd(0)),
+            fmu.get_real(vars::tension_cmd(1)),
+        ]);
+    }
+    for k in 1..10 {
+        assert_eq!(
+            tensions[k], tensions[0],
+            "step {k} changed the held tension"
+        );
+        assert_eq!(
+            tensions[10 + k],
+            tensions[10],
+            "step {} changed the held tension",
+            10 + k
+        );
+    }
+    assert_ne!(
+        tensions[10], tensions[0],
+        "the second sample did not compute anything new"
+    );
+}
+
+/// The sample instants are multiples of sample_time whatever the communication step.
+#[test]
+fn sampling_is_independent_of_the_communication_step() {
+    let first_tension = |h: f64, n: usize, expected_samples: i32| {
+        let fmu = initialized("rate");
+        assert_eq!(fmu.step(0.0, h), Fmi2Status::Ok, "{}", fmu.log_text());
+        let first = [
+            fmu.get_real(vars::tension_cmd(0)),
+            fmu.get_real(vars::tension_cmd(1)),
+        ];
+        steps(&fmu, h, h, n - 1);
+        assert_eq!(fmu.get_integer(vars::SAMPLES), expected_samples, "h = {h}");
+        first
+    };
+    // Samples at t = 0, 1 (8 steps of 0.25 s end at 2.0 s, the last step starts at 1.75).
+    let a = first_tension(0.25, 8, 2);
+    // Samples at t = 0, 1, 2.
+    let b = first_tension(1.0, 3, 3);
+    // Samples at t = 0, 1.0 (0.1 s steps: 1.0 arrives as 0.1 * 10 on the ns clock).
+    let c = first_tension(0.1, 11, 2);
+    // The first sample sees the same inputs: the same command, whatever h.
+    assert_eq!(a, b);
+    assert_eq!(a, c);
+
+    // sample_time 0.5 s with h = 0.25: samples at 0, 0.5, 1.0, 1.5.
+    let fmu = controller("half");
+    set_states(&fmu, &paper_states());
+    assert_eq!(fmu.set_real(var("sample_time"), 0.5), Fmi2Status::Ok);
+    fmu.init(0.0, None);
+    steps(&fmu, 0.0, 0.25, 8);
+    assert_eq!(fmu.get_integer(vars::SAMPLES), 4);
+}
+
+#[test]
+fn a_start_time_other_than_zero_keeps_the_sample_grid() {
+    let fmu = controller("t0");
+    set_states(&fmu, &paper_states());
+    fmu.init(100.0, None);
+    steps(&fmu, 100.0, 0.1, 11);
+    assert_eq!(fmu.get_integer(vars::SAMPLES), 2);
+}
+
+/// Regression guard: an obstacle exactly on the ship (a circle and a vessel at the ship's
+/// position) must not panic; the step is Ok or Warning and the commands stay in bounds.
+#[test]
+fn obstacles_on_top_of_the_ship_do_not_break_the_controller() {
+    let states = paper_states();
+    let ship = states[0];
+    let fmu = controller("overlap");
+    set_states(&fmu, &states);
+    set_obstacle(&fmu, 0, [ship[0], ship[1], 0.0, 0.0, 1.0, 1.0], 1);
+    set_obstacle(&fmu, 1, [ship[0], ship[1], ship[2], 0.1, 1.5, 0.5], 2);
+    fmu.init(0.0, None);
+    let mut t = 0.0;
+    for _ in 0..3 {
+        let s = fmu.step(t, 1.0);
+        assert!(
+            matches!(s, Fmi2Status::Ok | Fmi2Status::Warning),
+            "{s:?}: {}",
+            fmu.log_text()
+        );
+        if s == Fmi2Status::Warning {
+            assert!(fmu.log_text().contains("fallback: "), "{}", fmu.log_text());
+        }
+        t += 1.0;
+        assert_commands_within_bounds(&fmu);
+    }
+    assert_eq!(fmu.get_integer(vars::SAMPLES), 3);
+    let d_ob = fmu.get_real(vars::D_OB);
+    assert!(d_ob.is_finite() && d_ob < NO_OBSTACLE_DISTANCE, "{d_ob}");
+    // The vessel slot is classified (static and empty slots are -1).
+    assert_ne!(fmu.get_integer(vars::colregs_situation(1)), -1);
+    assert_eq!(fmu.get_integer(vars::colregs_situation(0)), -1);
+    assert_eq!(fmu.get_integer(vars::colregs_situation(2)), -1);
+}
+
+#[test]
+fn an_invalid_obstacle_is_an_error_naming_its_slot() {
+    let fmu = initialized("bad-obstacle");
+    // A vessel ellipse wider than long is refused by the guidance.
+    set_obstacle(&fmu, 2, [10.0, 10.0, 0.0, 0.1, 0.5, 1.0], 2);
+    assert_eq!(fmu.step(0.0, 0.1), Fmi2Status::Error);
+    assert!(
+        fmu.last_text().contains("obstacle[3]"),
+        "{}",
+        fmu.log_text()
+    );
+}
+
+#[test]
+fn fmu_state_functions_are_refused_as_declared() {
+    let fmu = initialized("state");
+    steps(&fmu, 0.0, 0.1, 1);
+    let (status, s) = fmu.try_get_state();
+    assert_eq!(status, Fmi2Status::Error);
+    assert!(s.is_null());
+    assert!(
+        fmu.last_text().contains("canGetAndSetFMUstate=\"false\""),
+        "{}",
+        fmu.log_text()
+    );
+    let fmu = initialized("serialize");
+    let (status, s) = fmu.deserialize(&[0u8; 16]);
+    assert_eq!(status, Fmi2Status::Error);
+    assert!(s.is_null());
+    assert!(
+        fmu.last_text().contains("canGetAndSetFMUstate=\"false\""),
+        "{}",
+        fmu.log_text()
+    );
+}
