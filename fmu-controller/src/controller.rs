@@ -25,11 +25,9 @@ use std::path::{Path, PathBuf};
 use towing_control::{
     Architecture, AvoidanceScheme, Command, Controller, ControllerConfig, Measurement, SampleReport,
 };
+use towing_interface::ScenarioFile;
 use towing_model::{HullModel, Scenario, MAX_OBSTACLES};
 use towing_mpc::HORIZON;
-
-/// Name of the bundled default scenario inside the FMU's `resources/` folder.
-pub const BUNDLED_SCENARIO: &str = "paper.toml";
 
 /// Tolerance of the sample-instant test (ns): a communication point within 1 us before a
 /// sample instant samples.
@@ -325,27 +323,12 @@ impl Clone for ControllerFmu {
     }
 }
 
-fn read_scenario(path: &Path) -> Result<(String, String), String> {
-    let origin = path.display().to_string();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("cannot read scenario file {origin}: {e}"))?;
-    Ok((origin, text))
-}
-
 impl ControllerFmu {
     /// Reads the scenario named by the `scenario` parameter (or the bundled one).
     fn load(&mut self, log: &Logger) -> Result<(), String> {
-        let (origin, text) = if self.params.scenario.is_empty() {
-            let dir = self.resource_dir.as_deref().ok_or_else(|| {
-                "the scenario parameter is empty and the FMU has no resources folder holding the bundled \
-                 paper scenario; set scenario to a file path"
-                    .to_owned()
-            })?;
-            read_scenario(&dir.join(BUNDLED_SCENARIO))?
-        } else {
-            read_scenario(Path::new(&self.params.scenario))?
-        };
-        let scenario = Scenario::from_toml_str(&text, &origin).map_err(|e| e.to_string())?;
+        let ScenarioFile {
+            origin, scenario, ..
+        } = ScenarioFile::load(&self.params.scenario, self.resource_dir.as_deref())?;
         log.info(
             "logEvents",
             &format!("scenario '{}' loaded from {origin}", scenario.name),

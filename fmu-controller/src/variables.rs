@@ -14,29 +14,27 @@
 //! |---|---|
 //! | 1..=9 | String and Integer parameters ([`SCENARIO`] .. [`MAX_ITERATIONS`]) |
 //! | 10..=99 | Real parameters ([`REAL_PARAMETERS`], `10 + index`) |
-//! | 100 + 10 vessel + c | vessel state inputs (ship 100.., tug1 110.., tug2 120..; as the plant's outputs) |
-//! | 200 + 10 tug + c, 220 + line | command outputs (as the plant's inputs) |
-//! | 300 + 10 line + field | towline inputs (as the plant's outputs) |
-//! | 1000 + 10 (k - 1) + j | obstacle slot k = 1..=8, field j (as the plant's outputs) |
+//! | 100..=1079 | the connected variables of `towing-interface` (vessel states, commands, towlines, obstacle slots) |
 //! | 3000..=3041 | diagnostics: ADMM, timing, reference, guidance, desired angles |
 //! | 3100 + 10 (k - 1) + j | COLREGS situation (j = 0) and role (j = 1) of obstacle slot k |
 //! | 3200 + 10 (h - 1) + j | predicted positions after sample h = 1..=3 (j: ship x, y, tug1 x, y, tug2 x, y) |
 
-use fmi2_slave::description::{
-    BaseUnit, Causality, DefaultExperiment, DisplayUnit, Initial, LogCategory, ModelDescription,
-    SimpleType, UnitDefinition, Variability, Variable, VariableKind,
-};
+use fmi2_slave::description::{ModelDescription, Variable, VariableKind};
 use std::sync::LazyLock;
 use towing_control::{ControllerConfig, InnerLoopParams, TrackingParams};
 use towing_guidance::GuidanceSettings;
+use towing_interface::variables::{self as shared, exact_output, parameter, Direction};
+use towing_interface::{ModelInfo, RealType, VESSELS};
 use towing_model::MAX_OBSTACLES;
 use towing_mpc::{AdmmSettings, PredictionParams, ShipMpcParams, TugMpcParams, HORIZON};
 
 /// The model identifier (binary name).
 pub const MODEL_IDENTIFIER: &str = "TowingController";
 
-/// `scenario` (String parameter): path of the scenario file; empty = bundled paper scenario.
-pub const SCENARIO: u32 = 1;
+pub use towing_interface::vr::{
+    obstacle, tension_cmd, towline, tug_force, vessel_state, OBSTACLE_KIND, SCENARIO,
+};
+
 /// `log_file` (String parameter): reserved for the MCAP log; must be empty for now.
 pub const LOG_FILE: u32 = 2;
 /// `hull_model` (Integer parameter): 0 as the scenario, 1 linear, 2 nonlinear damping.
@@ -47,30 +45,6 @@ pub const ARCHITECTURE: u32 = 4;
 pub const AVOIDANCE_SCHEME: u32 = 5;
 /// `max_iterations` (Integer parameter): the ADMM's `S`.
 pub const MAX_ITERATIONS: u32 = 6;
-
-/// Vessel state input: vessel 0 ship, 1 tug1, 2 tug2; component x, y, psi, u, v, r.
-pub const fn vessel_state(vessel: u32, component: u32) -> u32 {
-    100 + 10 * vessel + component
-}
-/// Command output: tug 0 (tug1) or 1 (tug2); component 0 surge force, 1 sway force, 2 yaw moment.
-pub const fn tug_force(tug: u32, component: u32) -> u32 {
-    200 + 10 * tug + component
-}
-/// Tension command output of towline 0 (towline1) or 1 (towline2).
-pub const fn tension_cmd(line: u32) -> u32 {
-    220 + line
-}
-/// Towline input: field 0 length, 1 angle, 2 tension.
-pub const fn towline_input(line: u32, field: u32) -> u32 {
-    300 + 10 * line + field
-}
-/// Obstacle slot input, `slot` 0-based; field index into [`OBSTACLE_FIELDS`], or
-/// [`OBSTACLE_KIND`] for the Integer kind.
-pub const fn obstacle_input(slot: u32, field: u32) -> u32 {
-    1000 + 10 * slot + field
-}
-/// Field index of the Integer `obstacle[k].kind` input within a slot.
-pub const OBSTACLE_KIND: u32 = 6;
 
 /// `admm.iterations` (Integer output).
 pub const ADMM_ITERATIONS: u32 = 3000;
@@ -122,108 +96,21 @@ pub const fn prediction(step: u32, vessel: u32, axis: u32) -> u32 {
 /// outputs must be finite.
 pub const NO_OBSTACLE_DISTANCE: f64 = 1e6;
 
-const VESSELS: [(&str, &str); 3] = [
-    ("ship", "ship (CyberShip II)"),
-    ("tug1", "aft tug (TitoNeri)"),
-    ("tug2", "forward tug (TitoNeri)"),
-];
-
-const STATES: [(&str, &str, &str); 6] = [
-    ("x", "m", "North position of the body origin (NED)"),
-    ("y", "m", "East position of the body origin (NED)"),
-    ("psi", "rad", "heading from North, clockwise positive"),
-    ("u", "m/s", "surge velocity (body frame)"),
-    ("v", "m/s", "sway velocity (body frame, starboard positive)"),
-    ("r", "rad/s", "yaw rate (clockwise positive)"),
-];
-
-const TUG_OUTPUTS: [(&str, &str, &str); 3] = [
-    (
-        "force_surge",
-        "N",
-        "commanded thruster force along the tug's body x axis (MPC thrust plus the inner loop, within the thrust limits)",
-    ),
-    (
-        "force_sway",
-        "N",
-        "commanded thruster force along the tug's body y axis (starboard; MPC thrust plus the inner loop, within the thrust limits)",
-    ),
-    (
-        "moment_yaw",
-        "N.m",
-        "commanded thruster moment about the tug's body z axis (clockwise positive; MPC thrust plus the inner loop, within the thrust limits)",
-    ),
-];
-
-/// Obstacle slot fields (Real ones; `kind` is the Integer field [`OBSTACLE_KIND`]).
-pub const OBSTACLE_FIELDS: [(&str, &str, &str); 6] = [
-    ("x", "m", "North position of the obstacle centre"),
-    ("y", "m", "East position of the obstacle centre"),
-    (
-        "psi",
-        "rad",
-        "course of a target ship (ignored for static hazards)",
-    ),
-    (
-        "speed",
-        "m/s",
-        "speed of a target ship (ignored for static hazards)",
-    ),
-    (
-        "length",
-        "m",
-        "major axis of a target ship's ellipse; diameter of a static circle",
-    ),
-    (
-        "width",
-        "m",
-        "minor axis of a target ship's ellipse; diameter of a static circle",
-    ),
-];
-
-/// Name of the Integer type of the `obstacle[k].kind` inputs (as the plant's).
-pub const OBSTACLE_KIND_TYPE: &str = "ObstacleKind";
-
-/// The Real types (`TypeDefinitions`): name, quantity, unit, display unit. The first seven
-/// are the plant's, so connected variables have the same declared types.
-const REAL_TYPES: [(&str, &str, &str, Option<&str>); 9] = [
-    ("Length", "Length", "m", None),
-    ("Angle", "Angle", "rad", Some("deg")),
-    ("Velocity", "Velocity", "m/s", None),
-    ("AngularVelocity", "AngularVelocity", "rad/s", Some("deg/s")),
-    ("Force", "Force", "N", None),
-    ("Torque", "Torque", "N.m", None),
-    ("Time", "Time", "s", None),
-    ("ForceRate", "ForceRate", "N/s", None),
-    ("Bandwidth", "Frequency", "1/s", None),
-];
-
-/// The declared type of a Real variable with unit `unit` (`None` for dimensionless ones).
-fn declared_type_of_unit(unit: &str) -> Option<&'static str> {
-    REAL_TYPES
-        .iter()
-        .find(|(_, _, u, _)| *u == unit)
-        .map(|(name, ..)| *name)
-}
-
-fn type_definitions() -> Vec<SimpleType> {
-    let mut types: Vec<SimpleType> = REAL_TYPES
-        .iter()
-        .map(|&(name, quantity, unit, display)| {
-            let t = SimpleType::real(name, quantity, unit);
-            match display {
-                Some(d) => t.with_display_unit(d),
-                None => t,
-            }
-        })
-        .collect();
-    types.push(
-        SimpleType::integer(OBSTACLE_KIND_TYPE, "ObstacleKind")
-            .with_integer_range(0, 2)
-            .with_description("0 none, 1 static circle, 2 vessel ellipse"),
-    );
-    types
-}
+/// The controller's model-description header: the Real types of the interface, plus those
+/// of the rate and bandwidth parameters.
+pub const INFO: ModelInfo = ModelInfo {
+    model_identifier: MODEL_IDENTIFIER,
+    description: "Towing controller of Du, Negenborn, Reppa (2022): COLREGS ship reference system, distributed (ADMM) or centralized MPC, \
+                  the tugs' inner loop; commands tug thrusts and towline tensions from the plant's measurements",
+    package: env!("CARGO_PKG_NAME"),
+    version: env!("CARGO_PKG_VERSION"),
+    log_events: "Life-cycle events of the controller (scenario loaded, controller built)",
+    extra_types: &[
+        RealType::new("ForceRate", "N/s", None, (1, 1, -3, 0)),
+        RealType::new("Bandwidth", "1/s", None, (0, 0, -1, 0)).with_quantity("Frequency"),
+    ],
+    fmu_state: false,
+};
 
 /// The tuning values the FMU's Real parameters read and write: the configuration's
 /// sub-structs without the scenario. [`Tunables::default`] holds the Rust defaults that
@@ -645,63 +532,11 @@ pub fn model_description_xml() -> String {
 }
 
 fn real_kind(unit: &str, start: Option<f64>) -> VariableKind {
-    let display_unit = match unit {
-        "rad" => Some("deg".to_owned()),
-        "rad/s" => Some("deg/s".to_owned()),
-        _ => None,
-    };
-    VariableKind::Real {
-        declared_type: declared_type_of_unit(unit).map(str::to_owned),
-        unit: (!unit.is_empty()).then(|| unit.to_owned()),
-        display_unit,
-        start,
-        min: None,
-        max: None,
-    }
-}
-
-fn input(
-    name: String,
-    vr: u32,
-    kind: VariableKind,
-    variability: Variability,
-    description: String,
-) -> Variable {
-    Variable {
-        name,
-        value_reference: vr,
-        description,
-        causality: Causality::Input,
-        variability,
-        initial: None,
-        kind,
-        output_dependencies: None,
-        initial_dependencies: None,
-    }
-}
-
-/// An output with `initial="exact"`: it holds its start value until the first `fmi2DoStep`
-/// computes it, and has no direct feedthrough from the inputs.
-fn output(name: String, vr: u32, kind: VariableKind, description: String) -> Variable {
-    let variability = match kind {
-        VariableKind::Real { .. } => Variability::Continuous,
-        _ => Variability::Discrete,
-    };
-    Variable {
-        name,
-        value_reference: vr,
-        description,
-        causality: Causality::Output,
-        variability,
-        initial: Some(Initial::Exact),
-        kind,
-        output_dependencies: Some(vec![]),
-        initial_dependencies: None,
-    }
+    INFO.real_kind(unit, start)
 }
 
 fn real_out(name: String, vr: u32, unit: &str, start: f64, description: String) -> Variable {
-    output(name, vr, real_kind(unit, Some(start)), description)
+    exact_output(name, vr, real_kind(unit, Some(start)), description)
 }
 
 fn int_kind(start: i32, min: i32, max: i32) -> VariableKind {
@@ -710,35 +545,6 @@ fn int_kind(start: i32, min: i32, max: i32) -> VariableKind {
         start: Some(start),
         min: Some(min),
         max: Some(max),
-    }
-}
-
-fn parameter(name: &str, vr: u32, kind: VariableKind, description: &str) -> Variable {
-    Variable {
-        name: name.to_owned(),
-        value_reference: vr,
-        description: description.to_owned(),
-        causality: Causality::Parameter,
-        variability: Variability::Fixed,
-        initial: Some(Initial::Exact),
-        kind,
-        output_dependencies: None,
-        initial_dependencies: None,
-    }
-}
-
-fn unit(name: &str, base: BaseUnit, display: Option<(&str, f64)>) -> UnitDefinition {
-    UnitDefinition {
-        name: name.to_owned(),
-        base,
-        display_units: display
-            .map(|(n, factor)| DisplayUnit {
-                name: n.to_owned(),
-                factor,
-                offset: 0.0,
-            })
-            .into_iter()
-            .collect(),
     }
 }
 
@@ -753,12 +559,7 @@ fn build() -> ModelDescription {
             .map_or(0, |(_, s)| *s)
     };
     let mut v = vec![
-        parameter(
-            "scenario",
-            SCENARIO,
-            VariableKind::String {
-                start: Some(String::new()),
-            },
+        shared::scenario_parameter(
             "Path of the scenario file (TOML, docs/scenario-format.md) giving the prediction models, formation, route and waterway; empty: the bundled paper scenario resources/paper.toml. Use the plant's scenario.",
         ),
         parameter(
@@ -807,95 +608,22 @@ fn build() -> ModelDescription {
         v.push(parameter(p.name, real_parameter_vr(i), kind, p.description));
     }
 
-    // Inputs: the plant's outputs.
-    for (i, (vessel, what)) in VESSELS.iter().enumerate() {
-        for (c, (field, unit, meaning)) in STATES.iter().enumerate() {
-            v.push(input(
-                format!("{vessel}.{field}"),
-                vessel_state(i as u32, c as u32),
-                real_kind(unit, Some(0.0)),
-                Variability::Continuous,
-                format!("measured {what}: {meaning}"),
-            ));
-        }
-    }
+    // Inputs: the plant's outputs; outputs: the plant's inputs.
+    v.extend(shared::vessel_states(Direction::Input));
     for line in 0..2u32 {
-        let n = line + 1;
-        for (f, (field, unit, meaning)) in [
-            ("length", "m", "distance between the attachment points"),
-            ("angle", "rad", "measured towing angle alpha"),
-            ("tension", "N", "measured tension"),
-        ]
-        .iter()
-        .enumerate()
-        {
-            v.push(input(
-                format!("towline{n}.{field}"),
-                towline_input(line, f as u32),
-                real_kind(unit, Some(0.0)),
-                Variability::Continuous,
-                format!("towline {n} {meaning} (plant output; accepted for connection by name, not used: the MPC predicts the lines from the formation geometry)"),
-            ));
-        }
+        v.extend(shared::towline(line, Direction::Input));
     }
-    for slot in 0..MAX_OBSTACLES as u32 {
-        let k = slot + 1;
-        for (j, (field, unit, meaning)) in OBSTACLE_FIELDS.iter().enumerate() {
-            v.push(input(
-                format!("obstacle[{k}].{field}"),
-                obstacle_input(slot, j as u32),
-                real_kind(unit, Some(0.0)),
-                Variability::Continuous,
-                format!("obstacle slot {k}: {meaning}"),
-            ));
-        }
-        v.push(input(
-            format!("obstacle[{k}].kind"),
-            obstacle_input(slot, OBSTACLE_KIND),
-            VariableKind::Integer {
-                declared_type: Some(OBSTACLE_KIND_TYPE.to_owned()),
-                start: Some(0),
-                min: Some(0),
-                max: Some(2),
-            },
-            Variability::Discrete,
-            format!("obstacle slot {k}: 0 none (ignored), 1 static circle, 2 vessel ellipse"),
-        ));
-    }
-
-    // Command outputs: the plant's inputs.
-    for tug in 0..2u32 {
-        for (c, (field, unit, what)) in TUG_OUTPUTS.iter().enumerate() {
-            v.push(real_out(
-                format!("tug{}.{field}", tug + 1),
-                tug_force(tug, c as u32),
-                unit,
-                0.0,
-                format!("{} {what}", VESSELS[tug as usize + 1].1),
-            ));
-        }
-    }
-    for line in 0..2u32 {
-        v.push(real_out(
-            format!("towline{}.tension_cmd", line + 1),
-            tension_cmd(line),
-            "N",
-            0.0,
-            format!(
-                "commanded towline {} tension of the last sample, held until the next (within [min_tension, max_tension])",
-                line + 1
-            ),
-        ));
-    }
+    v.extend(shared::obstacles(Direction::Input));
+    v.extend(shared::commands(Direction::Output));
 
     // Diagnostics.
-    v.push(output(
+    v.push(exact_output(
         "admm.iterations".into(),
         ADMM_ITERATIONS,
         int_kind(0, 0, i32::MAX),
         "ADMM iterations of the last sample (the centralized architecture reports its SCP loop count)".into(),
     ));
-    v.push(output(
+    v.push(exact_output(
         "admm.converged".into(),
         ADMM_CONVERGED,
         VariableKind::Boolean { start: Some(false) },
@@ -925,13 +653,13 @@ fn build() -> ModelDescription {
         0.0,
         "wall-clock time of the last sample (guidance and MPC); varies from run to run".into(),
     ));
-    v.push(output(
+    v.push(exact_output(
         "controller.fallbacks".into(),
         FALLBACKS,
         int_kind(0, 0, i32::MAX),
         "samples since instantiation whose plan was replaced by the previous plan, shifted (each one is reported with fmi2Warning \"fallback: <reason>\")".into(),
     ));
-    v.push(output(
+    v.push(exact_output(
         "controller.samples".into(),
         SAMPLES,
         int_kind(0, 0, i32::MAX),
@@ -946,13 +674,13 @@ fn build() -> ModelDescription {
             format!("reference pose {field} the ship MPC tracked in the last sample (eta_Sd of eq. (8), or the route waypoint in avoidance_scheme 3)"),
         ));
     }
-    v.push(output(
+    v.push(exact_output(
         "guidance.active_waypoint".into(),
         ACTIVE_WAYPOINT,
         int_kind(0, 0, i32::MAX),
         "index of the active waypoint in the route (1 = W_P1; the last is the destination; 0 before the first sample)".into(),
     ));
-    v.push(output(
+    v.push(exact_output(
         "guidance.altered".into(),
         ALTERED,
         VariableKind::Boolean { start: Some(false) },
@@ -979,13 +707,13 @@ fn build() -> ModelDescription {
     }
     for slot in 0..MAX_OBSTACLES as u32 {
         let k = slot + 1;
-        v.push(output(
+        v.push(exact_output(
             format!("colregs[{k}].situation"),
             colregs_situation(slot),
             int_kind(-1, -1, 6),
             format!("COLREGS situation with obstacle slot {k}: -1 none (empty slot or static hazard), 0 safe, 1 head-on, 2 crossing give-way, 3 crossing stand-on, 4 overtaking, 5 being overtaken, 6 unclassified (docs/colregs.md)"),
         ));
-        v.push(output(
+        v.push(exact_output(
             format!("colregs[{k}].role"),
             colregs_role(slot),
             int_kind(0, 0, 2),
@@ -1016,52 +744,5 @@ fn build() -> ModelDescription {
         }
     }
 
-    let deg = 180.0 / std::f64::consts::PI;
-    let base = |kg, m, s, rad| BaseUnit {
-        kg,
-        m,
-        s,
-        rad,
-        factor: 1.0,
-        ..BaseUnit::default()
-    };
-    ModelDescription {
-        model_name: MODEL_IDENTIFIER.to_owned(),
-        model_identifier: MODEL_IDENTIFIER.to_owned(),
-        description: "Towing controller of Du, Negenborn, Reppa (2022): COLREGS ship reference system, distributed (ADMM) or centralized MPC, \
-                      the tugs' inner loop; commands tug thrusts and towline tensions from the plant's measurements"
-            .to_owned(),
-        author: "Towing co-simulation developers".to_owned(),
-        version: env!("CARGO_PKG_VERSION").to_owned(),
-        generation_tool: format!("fmu-controller {} (fmi2-slave)", env!("CARGO_PKG_VERSION")),
-        units: vec![
-            unit("m", base(0, 1, 0, 0), None),
-            unit("m/s", base(0, 1, -1, 0), None),
-            unit("rad", base(0, 0, 0, 1), Some(("deg", deg))),
-            unit("rad/s", base(0, 0, -1, 1), Some(("deg/s", deg))),
-            unit("N", base(1, 1, -2, 0), None),
-            unit("N.m", base(1, 2, -2, 0), None),
-            unit("s", base(0, 0, 1, 0), None),
-            unit("N/s", base(1, 1, -3, 0), None),
-            unit("1/s", base(0, 0, -1, 0), None),
-        ],
-        type_definitions: type_definitions(),
-        log_categories: {
-            let mut c = LogCategory::standard();
-            c.push(LogCategory::new(
-                "logEvents",
-                "Life-cycle events of the controller (scenario loaded, controller built)",
-            ));
-            c
-        },
-        default_experiment: DefaultExperiment {
-            start_time: 0.0,
-            stop_time: 1200.0,
-            tolerance: None,
-            step_size: 0.1,
-        },
-        variables: v,
-        can_get_and_set_fmu_state: false,
-        can_serialize_fmu_state: false,
-    }
+    INFO.model_description(v)
 }

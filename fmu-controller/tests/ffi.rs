@@ -10,6 +10,7 @@ use fmi2_slave::ffi::Fmi2Status;
 use fmi2_slave::{Causality, ValueType, VariableKind};
 use support::*;
 use towing_controller::variables::{self as vars, DESCRIPTION, NO_OBSTACLE_DISTANCE};
+use towing_interface::testing;
 
 fn var(name: &str) -> u32 {
     DESCRIPTION
@@ -188,31 +189,12 @@ fn a_valid_non_default_parameter_set_is_accepted() {
 
 #[test]
 fn without_resources_and_scenario_initialization_is_refused_with_a_reason() {
-    let fmu =
-        fmi2_slave::testing::Fmu::try_new(exports(), &DESCRIPTION, "bare", None, false).unwrap();
-    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
-    assert_eq!(fmu.enter_init(), Fmi2Status::Error);
-    assert!(
-        fmu.last_text().contains("set scenario"),
-        "{}",
-        fmu.log_text()
-    );
+    testing::assert_no_resources_and_no_scenario_is_refused(exports(), &DESCRIPTION);
 }
 
 #[test]
 fn a_missing_scenario_file_is_named() {
-    let fmu = controller("missing");
-    assert_eq!(
-        fmu.set_string(vars::SCENARIO, "/nonexistent/route.toml"),
-        Fmi2Status::Ok
-    );
-    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
-    assert_eq!(fmu.enter_init(), Fmi2Status::Error);
-    assert!(
-        fmu.last_text().contains("/nonexistent/route.toml"),
-        "{}",
-        fmu.log_text()
-    );
+    testing::assert_missing_scenario_file_is_named(exports(), &DESCRIPTION);
 }
 
 /// With h = 0.1 and T_s = 1 s the tensions hold over the 10 steps of a sample and the
@@ -336,32 +318,20 @@ fn an_invalid_obstacle_is_an_error_naming_its_slot() {
     // A vessel ellipse wider than long is refused by the guidance.
     set_obstacle(&fmu, 2, [10.0, 10.0, 0.0, 0.1, 0.5, 1.0], 2);
     assert_eq!(fmu.step(0.0, 0.1), Fmi2Status::Error);
-    assert!(
-        fmu.last_text().contains("obstacle[3]"),
-        "{}",
-        fmu.log_text()
-    );
+    testing::assert_last_message_contains(&fmu, "obstacle[3]");
 }
 
 #[test]
 fn fmu_state_functions_are_refused_as_declared() {
+    let refused = |fmu: &fmi2_slave::testing::Fmu,
+                   (status, state): (Fmi2Status, fmi2_slave::ffi::Fmi2FmuState)| {
+        assert_eq!(status, Fmi2Status::Error);
+        assert!(state.is_null());
+        testing::assert_last_message_contains(fmu, "canGetAndSetFMUstate=\"false\"");
+    };
     let fmu = initialized("state");
     steps(&fmu, 0.0, 0.1, 1);
-    let (status, s) = fmu.try_get_state();
-    assert_eq!(status, Fmi2Status::Error);
-    assert!(s.is_null());
-    assert!(
-        fmu.last_text().contains("canGetAndSetFMUstate=\"false\""),
-        "{}",
-        fmu.log_text()
-    );
+    refused(&fmu, fmu.try_get_state());
     let fmu = initialized("serialize");
-    let (status, s) = fmu.deserialize(&[0u8; 16]);
-    assert_eq!(status, Fmi2Status::Error);
-    assert!(s.is_null());
-    assert!(
-        fmu.last_text().contains("canGetAndSetFMUstate=\"false\""),
-        "{}",
-        fmu.log_text()
-    );
+    refused(&fmu, fmu.deserialize(&[0u8; 16]));
 }

@@ -4,28 +4,12 @@
 #![allow(clippy::unwrap_used, clippy::float_cmp)]
 
 use fmi2_slave::{Causality, VariableKind};
-use std::path::Path;
 use towing_control::ControllerConfig;
 use towing_controller::variables::{model_description_xml, DESCRIPTION};
+use towing_interface::testing;
 use towing_model::Scenario;
 
-fn read(rel: &str) -> String {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel);
-    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
-
-#[test]
-fn description_is_consistent() {
-    DESCRIPTION.validate().unwrap();
-}
-
-#[test]
-fn committed_model_description_matches_the_variable_table() {
-    assert!(
-        read("modelDescription/TowingController.xml") == model_description_xml(),
-        "modelDescription/TowingController.xml is stale: run `cargo xtask model-description`"
-    );
-}
+towing_interface::model_description_tests!(DESCRIPTION);
 
 #[test]
 fn fmu_state_capabilities_are_declared_false() {
@@ -33,16 +17,6 @@ fn fmu_state_capabilities_are_declared_false() {
     assert!(xml.contains("canGetAndSetFMUstate=\"false\""), "{xml}");
     assert!(xml.contains("canSerializeFMUstate=\"false\""), "{xml}");
     assert!(xml.contains(&DESCRIPTION.guid()));
-}
-
-#[test]
-fn interface_document_lists_the_generated_variable_table() {
-    let doc = read("docs/interface.md");
-    let table = fmi2_slave::doc::variables_markdown(&DESCRIPTION);
-    assert!(
-        doc.contains(&table),
-        "docs/interface.md does not hold the current controller table: run `cargo xtask model-description`"
-    );
 }
 
 fn start_real(name: &str) -> f64 {
@@ -147,7 +121,7 @@ fn parameter_start_values_are_the_rust_defaults() {
 /// Every name a master connects by must exist in both FMUs with the same type and unit.
 #[test]
 fn connection_names_match_the_plant() {
-    let plant = read("modelDescription/TowingPlant.xml");
+    let plant = testing::read_repository_file("modelDescription/TowingPlant.xml");
     let mut checked = 0;
     for v in &DESCRIPTION.variables {
         if !matches!(v.causality, Causality::Input | Causality::Output) {
@@ -170,19 +144,15 @@ fn connection_names_match_the_plant() {
             "{}: value reference differs from the plant's: {element}",
             v.name
         );
+        let t = v.kind.declared_type().unwrap();
+        assert!(
+            element.contains(&format!("declaredType=\"{t}\"")),
+            "{}: {element}",
+            v.name
+        );
         match &v.kind {
-            VariableKind::Real {
-                declared_type,
-                unit,
-                ..
-            } => {
+            VariableKind::Real { unit, .. } => {
                 assert!(element.contains("<Real"), "{}", v.name);
-                let t = declared_type.as_deref().unwrap();
-                assert!(
-                    element.contains(&format!("declaredType=\"{t}\"")),
-                    "{}: {element}",
-                    v.name
-                );
                 let u = unit.as_deref().unwrap();
                 assert!(
                     element.contains(&format!("unit=\"{u}\"")),
@@ -190,15 +160,7 @@ fn connection_names_match_the_plant() {
                     v.name
                 );
             }
-            VariableKind::Integer { declared_type, .. } => {
-                assert!(element.contains("<Integer"), "{}", v.name);
-                let t = declared_type.as_deref().unwrap();
-                assert!(
-                    element.contains(&format!("declaredType=\"{t}\"")),
-                    "{}",
-                    v.name
-                );
-            }
+            VariableKind::Integer { .. } => assert!(element.contains("<Integer"), "{}", v.name),
             _ => panic!("{} has an unexpected type", v.name),
         }
         checked += 1;

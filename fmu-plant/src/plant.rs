@@ -8,35 +8,23 @@
 use crate::variables as vars;
 use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome};
 use std::path::{Path, PathBuf};
+use towing_interface::ScenarioFile;
 use towing_model::{
     HullModel, Scenario, TowlineModel, World, WorldConfig, WorldInputs, MAX_OBSTACLES,
 };
-
-/// Name of the bundled default scenario inside the FMU's `resources/` folder.
-pub const BUNDLED_SCENARIO: &str = "paper.toml";
 
 /// Version of [`Plant`]'s serialized state; bump on any layout change.
 const STATE_FORMAT_VERSION: u16 = 1;
 const STATE_MAGIC: &[u8; 4] = b"TWPL";
 
-/// Parameter values (FMI `parameter` variables).
-#[derive(Debug, Clone, PartialEq)]
+/// Parameter values (FMI `parameter` variables); all 0 (empty) by default: as the scenario
+/// says, the bundled scenario.
+#[derive(Debug, Clone, PartialEq, Default)]
 struct Parameters {
     scenario: String,
     hull_model: i32,
     towline_model: i32,
     integration_step: f64,
-}
-
-impl Default for Parameters {
-    fn default() -> Self {
-        Self {
-            scenario: String::new(),
-            hull_model: 0,
-            towline_model: 0,
-            integration_step: 0.0,
-        }
-    }
 }
 
 impl Parameters {
@@ -109,17 +97,11 @@ impl Plant {
     /// Reads the scenario named by the `scenario` parameter (or the bundled one) and builds the world.
     fn load(&mut self, log: &Logger) -> Result<(), String> {
         self.params.validate()?;
-        let (origin, text) = if self.params.scenario.is_empty() {
-            let dir = self.resource_dir.as_deref().ok_or_else(|| {
-                "the scenario parameter is empty and the FMU has no resources folder holding the bundled \
-                 paper scenario; set scenario to a file path"
-                    .to_owned()
-            })?;
-            read_scenario(&dir.join(BUNDLED_SCENARIO))?
-        } else {
-            read_scenario(Path::new(&self.params.scenario))?
-        };
-        let scenario = Scenario::from_toml_str(&text, &origin).map_err(|e| e.to_string())?;
+        let ScenarioFile {
+            origin,
+            text,
+            scenario,
+        } = ScenarioFile::load(&self.params.scenario, self.resource_dir.as_deref())?;
         let world = World::new(&scenario, self.params.world_config(&scenario))
             .map_err(|e| format!("{origin}: {e}"))?;
         log.info(
@@ -149,13 +131,6 @@ impl Plant {
     fn world(&self) -> Option<&World> {
         self.loaded.as_ref().map(|l| &l.world)
     }
-}
-
-fn read_scenario(path: &Path) -> Result<(String, String), String> {
-    let origin = path.display().to_string();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("cannot read scenario file {origin}: {e}"))?;
-    Ok((origin, text))
 }
 
 impl Fmi2Model for Plant {
@@ -273,7 +248,7 @@ impl Fmi2Model for Plant {
 
     fn get_boolean(&self, vr: u32) -> bool {
         for line in 0..2 {
-            if vr == vars::towline_output(line, 3) {
+            if vr == vars::towline(line, vars::TOWLINE_SLACK) {
                 return self.world().is_none_or(|w| w.towline(line as usize).slack);
             }
         }
@@ -392,7 +367,11 @@ impl Fmi2Model for Plant {
             let text = r.string()?;
             let world_bytes = r.bytes()?;
             restored.params.validate()?;
-            let scenario = Scenario::from_toml_str(&text, &origin).map_err(|e| e.to_string())?;
+            let ScenarioFile {
+                origin,
+                text,
+                scenario,
+            } = ScenarioFile::parse(origin, text)?;
             let config = restored.params.world_config(&scenario);
             let mut world = World::new(&scenario, config).map_err(|e| format!("{origin}: {e}"))?;
             world.read_state(world_bytes)?;

@@ -4,25 +4,22 @@
 //! `cargo xtask model-description`) and of `docs/interface.md`'s variable list. Names follow
 //! the interface contract of DESIGN.md so masters connect plant and controller by name.
 //!
-//! Value references are grouped by range (they are unique per FMI base type):
-//!
-//! | range | what |
-//! |---|---|
-//! | 1..=9 | parameters |
-//! | 100..=125 | vessel states (ship 100.., tug1 110.., tug2 120..) |
-//! | 200..=221 | inputs (tug forces 200.., 210.., tension commands 220, 221) |
-//! | 300..=313 | towline outputs (towline1 300.., towline2 310..) |
-//! | 1000 + 10 (k - 1) + j | obstacle slot k = 1..=8, field j |
+//! The connected variables (vessel states, towline values and obstacle slots as outputs, the
+//! commands as inputs) and their value references, units and declared types are those of
+//! the interface contract, `towing-interface`; this module adds the plant's parameters
+//! (value references 1..=9) and the Boolean outputs `towlineN.slack` (`vr::towline(line, 3)`).
 
-use fmi2_slave::description::{
-    BaseUnit, Causality, DefaultExperiment, DisplayUnit, Initial, LogCategory, ModelDescription,
-    SimpleType, UnitDefinition, Variability, Variable, VariableKind,
-};
+use fmi2_slave::description::{ModelDescription, VariableKind};
 use std::sync::LazyLock;
-use towing_model::{WorldConfig, MAX_OBSTACLES};
+use towing_interface::types::real_kind;
+use towing_interface::variables::{self as shared, parameter, Direction};
+use towing_interface::ModelInfo;
+use towing_model::WorldConfig;
 
-/// `scenario` (String parameter): path of the scenario file; empty = bundled paper scenario.
-pub const SCENARIO: u32 = 1;
+pub use towing_interface::vr::{
+    obstacle, tension_cmd, towline, tug_force, vessel_state, OBSTACLE_KIND, SCENARIO,
+};
+
 /// `hull_model` (Integer parameter): 1 linear damping, 2 nonlinear damping.
 pub const HULL_MODEL: u32 = 2;
 /// `towline_model` (Integer parameter): 1 ideal winch, 2 elastic line with winch.
@@ -30,220 +27,38 @@ pub const TOWLINE_MODEL: u32 = 3;
 /// `integration_step` (Real parameter, s): largest RK4 substep.
 pub const INTEGRATION_STEP: u32 = 4;
 
-/// First value reference of a vessel's six states x, y, psi, u, v, r (vessel 0 ship, 1 tug1, 2 tug2).
-pub const fn vessel_state(vessel: u32, component: u32) -> u32 {
-    100 + 10 * vessel + component
-}
-/// Tug input: tug 0 (tug1) or 1 (tug2); component 0 surge force, 1 sway force, 2 yaw moment.
-pub const fn tug_force(tug: u32, component: u32) -> u32 {
-    200 + 10 * tug + component
-}
-/// Tension command of towline 0 (towline1) or 1 (towline2).
-pub const fn tension_cmd(line: u32) -> u32 {
-    220 + line
-}
-/// Towline output: field 0 length, 1 angle, 2 tension, 3 slack (Boolean).
-pub const fn towline_output(line: u32, field: u32) -> u32 {
-    300 + 10 * line + field
-}
-/// Obstacle slot output, `slot` 0-based; field index into [`OBSTACLE_FIELDS`].
-pub const fn obstacle_output(slot: u32, field: u32) -> u32 {
-    1000 + 10 * slot + field
-}
+/// Field index of the Boolean `towlineN.slack` output within a towline's value references.
+pub const TOWLINE_SLACK: u32 = 3;
 
-/// Field index of the Integer `obstacle[k].kind` output within a slot.
-pub const OBSTACLE_KIND: u32 = 6;
-
-const VESSELS: [(&str, &str); 3] = [
-    ("ship", "ship (CyberShip II)"),
-    ("tug1", "aft tug (TitoNeri)"),
-    ("tug2", "forward tug (TitoNeri)"),
-];
-
-const STATES: [(&str, &str, &str); 6] = [
-    ("x", "m", "North position of the body origin (NED)"),
-    ("y", "m", "East position of the body origin (NED)"),
-    (
-        "psi",
-        "rad",
-        "heading from North, clockwise positive, wrapped to (-pi, pi]",
-    ),
-    ("u", "m/s", "surge velocity (body frame)"),
-    ("v", "m/s", "sway velocity (body frame, starboard positive)"),
-    ("r", "rad/s", "yaw rate (clockwise positive)"),
-];
-
-const TUG_INPUTS: [(&str, &str, &str); 3] = [
-    (
-        "force_surge",
-        "N",
-        "thruster force along the tug's body x axis",
-    ),
-    (
-        "force_sway",
-        "N",
-        "thruster force along the tug's body y axis (starboard)",
-    ),
-    (
-        "moment_yaw",
-        "N.m",
-        "thruster moment about the tug's body z axis (clockwise positive)",
-    ),
-];
-
-/// Obstacle slot fields (Real ones; `kind` is the Integer field [`OBSTACLE_KIND`]).
-pub const OBSTACLE_FIELDS: [(&str, &str, &str); 6] = [
-    ("x", "m", "North position of the obstacle centre"),
-    ("y", "m", "East position of the obstacle centre"),
-    (
-        "psi",
-        "rad",
-        "course of a target ship (0 for static hazards)",
-    ),
-    (
-        "speed",
-        "m/s",
-        "speed of a target ship (0 for static hazards and before activation)",
-    ),
-    (
-        "length",
-        "m",
-        "major axis of a target ship's ellipse; diameter of a static circle",
-    ),
-    (
-        "width",
-        "m",
-        "minor axis of a target ship's ellipse; diameter of a static circle",
-    ),
-];
+/// The plant's model-description header.
+pub const INFO: ModelInfo = ModelInfo {
+    model_identifier: MODEL_IDENTIFIER,
+    description: "Ship (CyberShip II) towed by two tugs (TitoNeri) through a waterway with static hazards and target ships; \
+                  Fossen 3-DoF hulls, towline forces from geometry (Du, Negenborn, Reppa 2022)",
+    package: env!("CARGO_PKG_NAME"),
+    version: env!("CARGO_PKG_VERSION"),
+    log_events: "Life-cycle events of the plant (scenario loaded, parameters applied)",
+    extra_types: &[],
+    fmu_state: true,
+};
 
 /// The model identifier (binary name).
 pub const MODEL_IDENTIFIER: &str = "TowingPlant";
 
-/// Name of the Integer type of the `obstacle[k].kind` outputs.
-pub const OBSTACLE_KIND_TYPE: &str = "ObstacleKind";
-
-/// The Real types (`TypeDefinitions`): name, quantity (the conventional Modelica name),
-/// unit, display unit. Every Real variable declares the type of its unit
-/// ([`declared_type_of_unit`]).
-const REAL_TYPES: [(&str, &str, &str, Option<&str>); 7] = [
-    ("Length", "Length", "m", None),
-    ("Angle", "Angle", "rad", Some("deg")),
-    ("Velocity", "Velocity", "m/s", None),
-    ("AngularVelocity", "AngularVelocity", "rad/s", Some("deg/s")),
-    ("Force", "Force", "N", None),
-    ("Torque", "Torque", "N.m", None),
-    ("Time", "Time", "s", None),
-];
-
-/// The declared type of a Real variable with unit `unit`.
-///
-/// # Panics
-/// If no type of [`REAL_TYPES`] has that unit (a programming error in the variable table).
-fn declared_type_of_unit(unit: &str) -> &'static str {
-    REAL_TYPES
-        .iter()
-        .find(|(_, _, u, _)| *u == unit)
-        .map(|(name, ..)| *name)
-        .unwrap_or_else(|| panic!("no SimpleType for unit '{unit}'"))
-}
-
-fn type_definitions() -> Vec<SimpleType> {
-    let mut types: Vec<SimpleType> = REAL_TYPES
-        .iter()
-        .map(|&(name, quantity, unit, display)| {
-            let t = SimpleType::real(name, quantity, unit);
-            match display {
-                Some(d) => t.with_display_unit(d),
-                None => t,
-            }
-        })
-        .collect();
-    types.push(
-        SimpleType::integer(OBSTACLE_KIND_TYPE, "ObstacleKind")
-            .with_integer_range(0, 2)
-            .with_description("0 none, 1 static circle, 2 vessel ellipse"),
-    );
-    types
-}
-
 /// The plant's model description, built once.
 pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(build);
 
-fn real(name: String, vr: u32, causality: Causality, unit: &str, description: String) -> Variable {
-    let (variability, initial, start, output_dependencies, initial_dependencies) = match causality {
-        Causality::Input => (Variability::Continuous, None, Some(0.0), None, None),
-        Causality::Output => (
-            Variability::Continuous,
-            Some(Initial::Calculated),
-            None,
-            Some(vec![]),
-            Some(vec![SCENARIO]),
-        ),
-        _ => (Variability::Fixed, Some(Initial::Exact), None, None, None),
-    };
-    let display_unit = match unit {
-        "rad" => Some("deg".to_owned()),
-        "rad/s" => Some("deg/s".to_owned()),
-        _ => None,
-    };
-    Variable {
-        name,
-        value_reference: vr,
-        description,
-        causality,
-        variability,
-        initial,
-        kind: VariableKind::Real {
-            declared_type: Some(declared_type_of_unit(unit).to_owned()),
-            unit: Some(unit.to_owned()),
-            display_unit,
-            start,
-            min: None,
-            max: None,
-        },
-        output_dependencies,
-        initial_dependencies,
-    }
-}
-
-fn parameter(name: &str, vr: u32, kind: VariableKind, description: &str) -> Variable {
-    Variable {
-        name: name.to_owned(),
-        value_reference: vr,
-        description: description.to_owned(),
-        causality: Causality::Parameter,
-        variability: Variability::Fixed,
-        initial: Some(Initial::Exact),
-        kind,
-        output_dependencies: None,
-        initial_dependencies: None,
-    }
-}
-
-fn unit(name: &str, base: BaseUnit, display: Option<(&str, f64)>) -> UnitDefinition {
-    UnitDefinition {
-        name: name.to_owned(),
-        base,
-        display_units: display
-            .map(|(n, factor)| DisplayUnit {
-                name: n.to_owned(),
-                factor,
-                offset: 0.0,
-            })
-            .into_iter()
-            .collect(),
-    }
-}
-
 fn build() -> ModelDescription {
+    let integration_step = {
+        let mut kind = real_kind("s", Some(0.0));
+        if let VariableKind::Real { min, max, .. } = &mut kind {
+            *min = Some(0.0);
+            *max = Some(WorldConfig::MAX_INTEGRATION_STEP);
+        }
+        kind
+    };
     let mut v = vec![
-        parameter(
-            "scenario",
-            SCENARIO,
-            VariableKind::String {
-                start: Some(String::new()),
-            },
+        shared::scenario_parameter(
             "Path of the scenario file (TOML, docs/scenario-format.md); empty: the bundled paper scenario resources/paper.toml",
         ),
         parameter(
@@ -271,171 +86,23 @@ fn build() -> ModelDescription {
         parameter(
             "integration_step",
             INTEGRATION_STEP,
-            VariableKind::Real {
-                declared_type: Some(declared_type_of_unit("s").to_owned()),
-                unit: Some("s".to_owned()),
-                display_unit: None,
-                start: Some(0.0),
-                min: Some(0.0),
-                max: Some(WorldConfig::MAX_INTEGRATION_STEP),
-            },
+            integration_step,
             "Largest fixed RK4 substep; a communication step h is split into ceil(h / integration_step) equal substeps; 0: as the scenario says (default 0.01 s)",
         ),
     ];
-
-    for (t, _) in VESSELS.iter().enumerate().skip(1) {
-        let tug = t as u32 - 1;
-        for (c, (field, unit, what)) in TUG_INPUTS.iter().enumerate() {
-            v.push(real(
-                format!("{}.{field}", VESSELS[t].0),
-                tug_force(tug, c as u32),
-                Causality::Input,
-                unit,
-                format!("{} {what}", VESSELS[t].1),
-            ));
-        }
-    }
-    for line in 0..2u32 {
-        v.push(real(
-            format!("towline{}.tension_cmd", line + 1),
-            tension_cmd(line),
-            Causality::Input,
-            "N",
-            format!(
-                "commanded towline {} tension (winch pull; values <= 0 leave the line slack)",
-                line + 1
-            ),
-        ));
-    }
-
-    for (i, (vessel, what)) in VESSELS.iter().enumerate() {
-        for (c, (field, unit, meaning)) in STATES.iter().enumerate() {
-            v.push(real(
-                format!("{vessel}.{field}"),
-                vessel_state(i as u32, c as u32),
-                Causality::Output,
-                unit,
-                format!("{what}: {meaning}"),
-            ));
-        }
-    }
-
+    v.extend(shared::commands(Direction::Input));
+    v.extend(shared::vessel_states(Direction::Output));
     for line in 0..2u32 {
         let n = line + 1;
-        let ends = if line == 0 {
-            "ship stern point to the aft tug's bow point"
-        } else {
-            "ship bow point to the forward tug's stern point"
-        };
-        v.push(real(
-            format!("towline{n}.length"),
-            towline_output(line, 0),
-            Causality::Output,
-            "m",
-            format!("distance between the towline {n} attachment points ({ends})"),
+        v.extend(shared::towline(line, Direction::Output));
+        v.push(shared::calculated_output(
+            format!("towline{n}.slack"),
+            towline(line, TOWLINE_SLACK),
+            VariableKind::Boolean { start: None },
+            format!("true when towline {n} transmitted no force at the end of the last step"),
+            vec![],
         ));
-        v.push(real(
-            format!("towline{n}.angle"),
-            towline_output(line, 1),
-            Causality::Output,
-            "rad",
-            format!("towing angle alpha_{n} (Du et al. 2022, eq. (4)-(6), consistent form of docs/interface.md): towline direction relative to the ship heading"),
-        ));
-        let mut tension = real(
-            format!("towline{n}.tension"),
-            towline_output(line, 2),
-            Causality::Output,
-            "N",
-            format!("tension applied by towline {n} during the last communication step (mean over the substeps)"),
-        );
-        tension.initial_dependencies = Some(vec![]);
-        v.push(tension);
-        v.push(Variable {
-            name: format!("towline{n}.slack"),
-            value_reference: towline_output(line, 3),
-            description: format!(
-                "true when towline {n} transmitted no force at the end of the last step"
-            ),
-            causality: Causality::Output,
-            variability: Variability::Discrete,
-            initial: Some(Initial::Calculated),
-            kind: VariableKind::Boolean { start: None },
-            output_dependencies: Some(vec![]),
-            initial_dependencies: Some(vec![]),
-        });
     }
-
-    for slot in 0..MAX_OBSTACLES as u32 {
-        let k = slot + 1;
-        for (j, (field, unit, meaning)) in OBSTACLE_FIELDS.iter().enumerate() {
-            v.push(real(
-                format!("obstacle[{k}].{field}"),
-                obstacle_output(slot, j as u32),
-                Causality::Output,
-                unit,
-                format!("obstacle slot {k}: {meaning}"),
-            ));
-        }
-        v.push(Variable {
-            name: format!("obstacle[{k}].kind"),
-            value_reference: obstacle_output(slot, OBSTACLE_KIND),
-            description: format!(
-                "obstacle slot {k}: 0 none (empty slot or target ship not yet active), 1 static circle, 2 vessel ellipse"
-            ),
-            causality: Causality::Output,
-            variability: Variability::Discrete,
-            initial: Some(Initial::Calculated),
-            kind: VariableKind::Integer {
-                declared_type: Some(OBSTACLE_KIND_TYPE.to_owned()),
-                start: None,
-                min: Some(0),
-                max: Some(2),
-            },
-            output_dependencies: Some(vec![]),
-            initial_dependencies: Some(vec![SCENARIO]),
-        });
-    }
-
-    let m = |m| BaseUnit {
-        m,
-        factor: 1.0,
-        ..BaseUnit::default()
-    };
-    let deg = 180.0 / std::f64::consts::PI;
-    ModelDescription {
-        model_name: MODEL_IDENTIFIER.to_owned(),
-        model_identifier: MODEL_IDENTIFIER.to_owned(),
-        description: "Ship (CyberShip II) towed by two tugs (TitoNeri) through a waterway with static hazards and target ships; \
-                      Fossen 3-DoF hulls, towline forces from geometry (Du, Negenborn, Reppa 2022)".to_owned(),
-        author: "Towing co-simulation developers".to_owned(),
-        version: env!("CARGO_PKG_VERSION").to_owned(),
-        generation_tool: format!("fmu-plant {} (fmi2-slave)", env!("CARGO_PKG_VERSION")),
-        units: vec![
-            unit("m", m(1), None),
-            unit("m/s", BaseUnit { m: 1, s: -1, factor: 1.0, ..BaseUnit::default() }, None),
-            unit("rad", BaseUnit { rad: 1, factor: 1.0, ..BaseUnit::default() }, Some(("deg", deg))),
-            unit("rad/s", BaseUnit { rad: 1, s: -1, factor: 1.0, ..BaseUnit::default() }, Some(("deg/s", deg))),
-            unit("N", BaseUnit { kg: 1, m: 1, s: -2, factor: 1.0, ..BaseUnit::default() }, None),
-            unit("N.m", BaseUnit { kg: 1, m: 2, s: -2, factor: 1.0, ..BaseUnit::default() }, None),
-            unit("s", BaseUnit { s: 1, factor: 1.0, ..BaseUnit::default() }, None),
-        ],
-        type_definitions: type_definitions(),
-        log_categories: {
-            let mut c = LogCategory::standard();
-            c.push(LogCategory::new(
-                "logEvents",
-                "Life-cycle events of the plant (scenario loaded, parameters applied)",
-            ));
-            c
-        },
-        default_experiment: DefaultExperiment {
-            start_time: 0.0,
-            stop_time: 1200.0,
-            tolerance: None,
-            step_size: 0.1,
-        },
-        variables: v,
-        can_get_and_set_fmu_state: true,
-        can_serialize_fmu_state: true,
-    }
+    v.extend(shared::obstacles(Direction::Output));
+    INFO.model_description(v)
 }

@@ -5,29 +5,16 @@
 
 use fmi2_slave::ffi::Fmi2Status;
 use fmi2_slave::testing::{Exports, Fmu};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
+use towing_interface::testing;
 use towing_plant::variables::{self as vars, DESCRIPTION};
 
 fn exports() -> Exports {
     fmi2_slave::exports_of!(towing_plant)
 }
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-/// The repository's `scenarios/` folder as a resource URI: it holds `paper.toml`, like the
-/// packaged FMU's `resources/`.
-fn resources_uri() -> String {
-    format!("file://{}", root().join("scenarios").display()).replace(' ', "%20")
-}
-
 fn plant(name: &str) -> Fmu {
-    Fmu::try_new(exports(), &DESCRIPTION, name, Some(&resources_uri()), false)
-        .unwrap_or_else(|log| panic!("instantiate failed: {log:?}"))
+    testing::instantiate(exports(), &DESCRIPTION, name)
 }
 
 const PULL: [(u32, f64); 2] = [(vars::tug_force(1, 0), 3.0), (vars::tension_cmd(1), 2.0)];
@@ -77,26 +64,13 @@ fn default_scenario_comes_from_the_resources_folder() {
     fmu.init(0.0, None);
     assert_eq!(fmu.get_real(vars::vessel_state(0, 0)), -4.9);
     assert_eq!(fmu.get_real(vars::vessel_state(0, 1)), 7.0);
-    assert_eq!(
-        fmu.get_integer(vars::obstacle_output(0, vars::OBSTACLE_KIND)),
-        1
-    );
-    assert_eq!(
-        fmu.get_integer(vars::obstacle_output(6, vars::OBSTACLE_KIND)),
-        0
-    );
+    assert_eq!(fmu.get_integer(vars::obstacle(0, vars::OBSTACLE_KIND)), 1);
+    assert_eq!(fmu.get_integer(vars::obstacle(6, vars::OBSTACLE_KIND)), 0);
 }
 
 #[test]
 fn without_resources_and_scenario_initialization_is_refused_with_a_reason() {
-    let fmu = Fmu::try_new(exports(), &DESCRIPTION, "bare", None, false).unwrap();
-    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
-    assert_eq!(fmu.enter_init(), Fmi2Status::Error);
-    assert!(
-        fmu.last_text().contains("set scenario"),
-        "{}",
-        fmu.log_text()
-    );
+    testing::assert_no_resources_and_no_scenario_is_refused(exports(), &DESCRIPTION);
 }
 
 #[test]
@@ -137,11 +111,7 @@ fn null_component_is_an_error_not_a_crash() {
 fn wrong_call_order_is_an_error() {
     let fmu = plant("order");
     assert_eq!(fmu.step(0.0, 0.1), Fmi2Status::Error);
-    assert!(
-        fmu.last_text().contains("Illegal call sequence"),
-        "{}",
-        fmu.log_text()
-    );
+    testing::assert_last_message_contains(&fmu, "Illegal call sequence");
 }
 
 #[test]
@@ -149,7 +119,7 @@ fn unknown_value_reference_is_an_error_naming_it() {
     let fmu = plant("unknown");
     fmu.init(0.0, None);
     assert_eq!(fmu.set_real(4242, 1.0).clone(), Fmi2Status::Error);
-    assert!(fmu.last_text().contains("4242"), "{}", fmu.log_text());
+    testing::assert_last_message_contains(&fmu, "4242");
 }
 
 #[test]
@@ -163,11 +133,7 @@ fn non_finite_inputs_are_refused_naming_the_variable_and_keeping_the_value() {
         let vr = vars::tug_force(0, 2);
         assert_eq!(fmu.set_real(vr, 1.5), Fmi2Status::Ok);
         assert_eq!(fmu.set_real(vr, bad), Fmi2Status::Error);
-        assert!(
-            fmu.last_text().contains("tug1.moment_yaw"),
-            "{}",
-            fmu.log_text()
-        );
+        testing::assert_last_message_contains(&fmu, "tug1.moment_yaw");
         assert_eq!(fmu.get_real(vr), 1.5, "previous value kept");
     }
 }
@@ -179,23 +145,16 @@ fn bad_parameters_are_refused_naming_the_parameter() {
     assert!(fmu.last_text().contains("hull_model") && fmu.last_text().contains('7'));
     let fmu = plant("params2");
     assert_eq!(fmu.set_real(vars::INTEGRATION_STEP, 0.5), Fmi2Status::Error);
-    assert!(
-        fmu.last_text().contains("integration_step"),
-        "{}",
-        fmu.log_text()
-    );
+    testing::assert_last_message_contains(&fmu, "integration_step");
     let fmu = plant("params3");
     assert_eq!(fmu.set_integer(vars::TOWLINE_MODEL, -1), Fmi2Status::Error);
-    assert!(
-        fmu.last_text().contains("towline_model"),
-        "{}",
-        fmu.log_text()
-    );
+    testing::assert_last_message_contains(&fmu, "towline_model");
 }
 
 /// The paper scenario with one replacement applied (the original text must be present).
 fn edited_paper(from: &str, to: &str) -> String {
-    let text = std::fs::read_to_string(root().join("scenarios/paper.toml")).unwrap();
+    let text =
+        std::fs::read_to_string(testing::workspace_root().join("scenarios/paper.toml")).unwrap();
     assert!(text.contains(from), "paper.toml lacks {from:?}");
     text.replacen(from, to, 1)
 }
@@ -318,18 +277,7 @@ fn every_kind_of_bad_scenario_is_refused_naming_file_field_and_reason() {
 
 #[test]
 fn a_missing_scenario_file_is_refused_naming_it() {
-    let fmu = plant("missing");
-    assert_eq!(
-        fmu.set_string(vars::SCENARIO, "/nonexistent/dir/s.toml"),
-        Fmi2Status::Ok
-    );
-    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
-    assert_eq!(fmu.enter_init(), Fmi2Status::Error);
-    assert!(
-        fmu.last_text().contains("/nonexistent/dir/s.toml"),
-        "{}",
-        fmu.log_text()
-    );
+    testing::assert_missing_scenario_file_is_named(exports(), &DESCRIPTION);
 }
 
 #[test]

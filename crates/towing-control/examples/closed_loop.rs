@@ -11,6 +11,108 @@ use towing_control::{AvoidanceScheme, Controller, ControllerConfig, Measurement}
 use towing_guidance::ObstacleInput;
 use towing_model::{Scenario, World, WorldInputs};
 
+/// Hull outline (rectangle `length x width` at the pose) as boundary samples.
+fn rect_points(eta: [f64; 3], length: f64, width: f64) -> Vec<[f64; 2]> {
+    let (sn, cs) = eta[2].sin_cos();
+    let mut pts = Vec::new();
+    let n = 16;
+    for k in 0..n {
+        let t = k as f64 / n as f64;
+        for (a, b) in [
+            (-0.5 + t, -0.5),
+            (0.5, -0.5 + t),
+            (0.5 - t, 0.5),
+            (-0.5, 0.5 - t),
+        ] {
+            let (bx, by) = (a * length, b * width);
+            pts.push([eta[0] + cs * bx - sn * by, eta[1] + sn * bx + cs * by]);
+        }
+    }
+    pts
+}
+
+fn in_rect(p: [f64; 2], eta: [f64; 3], length: f64, width: f64) -> bool {
+    let (sn, cs) = eta[2].sin_cos();
+    let (dx, dy) = (p[0] - eta[0], p[1] - eta[1]);
+    let (bx, by) = (cs * dx + sn * dy, -sn * dx + cs * dy);
+    bx.abs() <= 0.5 * length && by.abs() <= 0.5 * width
+}
+
+/// Overlap of the tow's hulls with the obstacles and with each other.
+fn overlaps(world: &World, scenario: &Scenario) -> Vec<String> {
+    let hulls = [
+        (
+            "ship",
+            world.ship().eta,
+            scenario.ship_data.length,
+            scenario.ship_data.width,
+        ),
+        (
+            "tug1",
+            world.tug(0).eta,
+            scenario.tug_data[0].length,
+            scenario.tug_data[0].width,
+        ),
+        (
+            "tug2",
+            world.tug(1).eta,
+            scenario.tug_data[1].length,
+            scenario.tug_data[1].width,
+        ),
+    ];
+    let mut out = Vec::new();
+    for (name, eta, l, w) in hulls {
+        let pts = rect_points(eta, l, w);
+        for k in 0..towing_model::MAX_OBSTACLES {
+            let o = world.obstacle(k);
+            let hit = match o.kind {
+                1 => {
+                    let r = 0.5 * o.length.max(o.width);
+                    pts.iter().any(|p| (p[0] - o.x).hypot(p[1] - o.y) < r)
+                        || in_rect([o.x, o.y], eta, l, w)
+                }
+                2 => {
+                    let (a, b) = (0.5 * o.length, 0.5 * o.width);
+                    let (sn, cs) = o.psi.sin_cos();
+                    let inside = |p: &[f64; 2]| {
+                        let (dx, dy) = (p[0] - o.x, p[1] - o.y);
+                        let (ex, ey) = (cs * dx + sn * dy, -sn * dx + cs * dy);
+                        (ex / a).powi(2) + (ey / b).powi(2) < 1.0
+                    };
+                    let ell: Vec<[f64; 2]> = (0..64)
+                        .map(|k| {
+                            let t = k as f64 / 64.0 * std::f64::consts::TAU;
+                            let (ex, ey) = (a * t.cos(), b * t.sin());
+                            [o.x + cs * ex - sn * ey, o.y + sn * ex + cs * ey]
+                        })
+                        .collect();
+                    pts.iter().any(inside) || ell.iter().any(|p| in_rect(*p, eta, l, w))
+                }
+                _ => false,
+            };
+            if hit {
+                out.push(format!("{name} x obstacle[{}]", k + 1));
+            }
+        }
+    }
+    for i in 0..3 {
+        for j in i + 1..3 {
+            let (ni, ei, li, wi) = hulls[i];
+            let (nj, ej, lj, wj) = hulls[j];
+            if rect_points(ei, li, wi)
+                .iter()
+                .any(|p| in_rect(*p, ej, lj, wj))
+                || rect_points(ej, lj, wj)
+                    .iter()
+                    .any(|p| in_rect(*p, ei, li, wi))
+            {
+                out.push(format!("{ni} x {nj}"));
+            }
+        }
+    }
+    out
+}
+
 fn measure(world: &World) -> Measurement {
     let v =
         |s: &towing_model::VesselState| [s.eta[0], s.eta[1], s.eta[2], s.nu[0], s.nu[1], s.nu[2]];
@@ -66,10 +168,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         config.admm.rho = v;
     }
     if let Some(v) = env("LOS") {
-        config.los_distance = v;
+        config.tracking.los_distance = v;
     }
     if let Some(v) = env("LOOKAHEAD") {
-        config.lookahead = v;
+        config.tracking.lookahead = v;
     }
     if let Some(v) = env("W_S1") {
         config.ship.weights[0] = v;
@@ -86,6 +188,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(v) = env("ARCH") {
         config.architecture = towing_control::Architecture::from_code(v as i32)?;
     }
+    if let Some(v) = env("EPS") {
+        config.ship.distance.epsilon = v;
+        config.tug.distance.epsilon = v;
+    }
+    if let Some(v) = env("CENT_TOL") {
+        config.centralized.tolerance = v;
+    }
+    if let (Some(w), Some(t)) = (env("TERM_W"), env("TERM_T")) {
+        config.ship.terminal = Some(towing_mpc::TerminalCost {
+            weight: w,
+            horizon: t,
+        });
+    }
     let mut controller = Controller::new(config)?;
     let mut csv = match args.get(3) {
         Some(path) => Some(std::io::BufWriter::new(std::fs::File::create(path)?)),
@@ -100,6 +215,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut min_clear = f64::INFINITY;
     let dest = scenario.route.destination;
     let mut settled_since: Option<f64> = None;
+    let mut collisions = 0usize;
     let wall = std::time::Instant::now();
     for n in 0..steps {
         let m = measure(&world);
@@ -190,6 +306,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 settled_since = Some(world.time());
             }
         }
+        if n % 5 == 0 {
+            for o in overlaps(&world, &scenario) {
+                collisions += 1;
+                if collisions <= 5 {
+                    eprintln!("t = {:.1}: overlap {o}", world.time());
+                }
+            }
+        }
         // Clearance to every active obstacle (centre distance minus radius, crude).
         for k in 0..towing_model::MAX_OBSTACLES {
             let o = world.obstacle(k);
@@ -206,11 +330,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     iters.sort_unstable();
     let s = world.ship();
     println!(
-        "end t={:.0}: ship at ({:.2}, {:.2}) psi {:.1} deg, u {:.3}; wall {:.2} s; sample ms median {:.2} p99 {:.2} max {:.2}; iterations median {} p99 {} max {}; not converged {}; fallbacks {}; min crude clearance {:.2} m; settled at {:?}",
+        "end t={:.0}: ship at ({:.2}, {:.2}) psi {:.1} deg, u {:.3}; wall {:.2} s; sample ms median {:.2} p99 {:.2} max {:.2}; iterations median {} p99 {} max {}; not converged {}; fallbacks {}; min crude clearance {:.2} m; settled at {:?}; overlaps {}",
         world.time(), s.eta[0], s.eta[1], s.eta[2].to_degrees(), s.nu[0], wall.elapsed().as_secs_f64(),
         times[times.len() / 2], times[times.len() * 99 / 100], times[times.len() - 1],
         iters[iters.len() / 2], iters[iters.len() * 99 / 100], iters[iters.len() - 1], not_converged,
-        controller.fallbacks(), min_clear, settled_since
+        controller.fallbacks(), min_clear, settled_since, collisions
     );
     Ok(())
 }

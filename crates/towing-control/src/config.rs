@@ -124,6 +124,33 @@ impl Default for InnerLoopParams {
     }
 }
 
+/// How the MPC tracks the reference (`docs/controller-design.md`, "Reference").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackingParams {
+    /// Lookahead distance (m) of the tracked point on the active leg
+    /// ([`Controller`](crate::Controller) docs); 0 tracks the reference
+    /// system's waypoint `eta_Sd` itself, as the paper does.
+    pub lookahead: f64,
+    /// Line-of-sight distance (m): while the ship is farther than this from the
+    /// tracked point, the reference heading is the bearing from the ship to it
+    /// (line of sight, Fossen 2011, section 10.3.2) instead of the waypoint's
+    /// heading of Table 4 / eq. (11); 0 turns it off. On the route the two are
+    /// equal; off the route (after an avoidance) the printed heading and a short
+    /// horizon leave the ship in a local minimum beside its waypoint.
+    pub los_distance: f64,
+}
+
+impl Default for TrackingParams {
+    /// `lookahead = 3 m`, `los_distance = 2.5 m` (two CyberShip II lengths);
+    /// why in `docs/assumptions.md`.
+    fn default() -> Self {
+        TrackingParams {
+            lookahead: 3.0,
+            los_distance: 2.5,
+        }
+    }
+}
+
 /// Everything the controller needs; [`ControllerConfig::new`] gives the
 /// documented defaults for a scenario.
 #[derive(Debug, Clone)]
@@ -150,18 +177,8 @@ pub struct ControllerConfig {
     pub guidance: GuidanceSettings,
     /// The tugs' inner loop.
     pub inner: InnerLoopParams,
-    /// Line-of-sight distance (m): while the ship is farther than this from the
-    /// reference waypoint, the reference heading is the bearing from the ship
-    /// to the waypoint (line of sight, Fossen 2011, section 10.3.2) instead of
-    /// the waypoint's heading of Table 4 / eq. (11); 0 turns it off. On the
-    /// route the two are equal; off the route (after an avoidance) the printed
-    /// heading and a short horizon leave the ship in a local minimum beside
-    /// its waypoint (`docs/assumptions.md`).
-    pub los_distance: f64,
-    /// Lookahead distance (m) of the tracked point on the active leg
-    /// ([`Controller`](crate::Controller) docs); 0 tracks the reference
-    /// system's waypoint `eta_Sd` itself, as the paper does.
-    pub lookahead: f64,
+    /// How the MPC tracks the reference system's output.
+    pub tracking: TrackingParams,
 }
 
 impl ControllerConfig {
@@ -176,7 +193,6 @@ impl ControllerConfig {
             tug_length: scenario.tug_data[0].length.max(scenario.tug_data[1].length),
             ..GuidanceSettings::default()
         };
-        let scenario_ship_length = scenario.ship_data.length;
         ControllerConfig {
             hull: scenario.world_config.hull_model,
             scenario,
@@ -189,8 +205,7 @@ impl ControllerConfig {
             tug: TugMpcParams::default(),
             guidance,
             inner: InnerLoopParams::default(),
-            los_distance: 2.0 * scenario_ship_length,
-            lookahead: 3.0,
+            tracking: TrackingParams::default(),
         }
     }
 
@@ -229,17 +244,16 @@ impl ControllerConfig {
                 ));
             }
         }
-        if !(self.lookahead.is_finite() && self.lookahead >= 0.0) {
-            return Err(ConfigError::new(
-                "lookahead",
-                format!("must be finite and >= 0, got {}", self.lookahead),
-            ));
-        }
-        if !(self.los_distance.is_finite() && self.los_distance >= 0.0) {
-            return Err(ConfigError::new(
-                "los_distance",
-                format!("must be finite and >= 0, got {}", self.los_distance),
-            ));
+        for (name, v) in [
+            ("lookahead", self.tracking.lookahead),
+            ("los_distance", self.tracking.los_distance),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(ConfigError::new(
+                    name,
+                    format!("must be finite and >= 0, got {v}"),
+                ));
+            }
         }
         self.route()?;
         Ok(())

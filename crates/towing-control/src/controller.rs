@@ -30,8 +30,8 @@ use towing_guidance::{
 };
 use towing_model::{VesselData, MAX_OBSTACLES};
 use towing_mpc::{
-    Admm, AppliedCommand, Centralized, Obstacle, SampleInput, ShipInput, ShipModel, ShipState,
-    TugInput, TugState, HORIZON,
+    Admm, AppliedCommand, Centralized, Obstacle, QpOutcome, SampleInput, ShipInput, ShipModel,
+    ShipState, TugInput, TugState, HORIZON,
 };
 
 use crate::config::{Architecture, ControllerConfig, InnerLoopParams};
@@ -133,11 +133,36 @@ pub struct SampleReport {
     /// Wall time of the sample (s).
     pub compute_time: f64,
     /// Why the fallback plan was applied, if it was.
-    pub fallback: Option<&'static str>,
+    pub fallback: Option<Fallback>,
     /// Fallbacks since instantiation.
     pub fallbacks: u64,
     /// Predicted trajectories of the plan.
     pub prediction: Prediction,
+}
+
+/// Why a sample applied the fallback plan.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Fallback {
+    /// The last QP of a subproblem gave no usable solution.
+    SolveFailed {
+        /// `tug 1`, `tug 2`, `ship` or `centralized`.
+        problem: &'static str,
+        /// Clarabel's outcome.
+        outcome: QpOutcome,
+    },
+    /// The plan holds a NaN or an infinity.
+    NonFinitePlan,
+}
+
+impl std::fmt::Display for Fallback {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Fallback::SolveFailed { problem, outcome } => {
+                write!(f, "the {problem} QP gave no usable solution ({outcome:?})")
+            }
+            Fallback::NonFinitePlan => write!(f, "the plan is not finite"),
+        }
+    }
 }
 
 /// The controller (module docs).
@@ -309,10 +334,10 @@ impl Controller {
         let tug_plans = [*self.solver.tug_plan(0), *self.solver.tug_plan(1)];
         let finite = ship_plan.iter().flatten().all(|v| v.is_finite())
             && tug_plans.iter().flatten().flatten().all(|v| v.is_finite());
-        let fallback = if report.failed {
-            Some("a subproblem's last QP solve failed")
+        let fallback = if let Some((problem, outcome)) = report.failed {
+            Some(Fallback::SolveFailed { problem, outcome })
         } else if !finite {
-            Some("the plan is not finite")
+            Some(Fallback::NonFinitePlan)
         } else {
             None
         };
@@ -421,7 +446,7 @@ impl Controller {
         let points = self.guidance.route().points();
         let last = points.len() - 1;
         let mut goal = target.eta();
-        let lookahead = self.config.lookahead;
+        let lookahead = self.config.tracking.lookahead;
         if lookahead > 0.0 {
             let prev = points[active - 1];
             let seg = [target.x - prev.x, target.y - prev.y];
@@ -449,7 +474,8 @@ impl Controller {
             }
         }
         let (dx, dy) = (goal[0] - ship[0], goal[1] - ship[1]);
-        if self.config.los_distance > 0.0 && dx.hypot(dy) > self.config.los_distance {
+        let los = self.config.tracking.los_distance;
+        if los > 0.0 && dx.hypot(dy) > los {
             goal[2] = dy.atan2(dx);
         }
         goal
@@ -509,12 +535,13 @@ impl Controller {
             [m.tugs[0][0], m.tugs[0][1]],
             [m.tugs[1][0], m.tugs[1][1]],
         ];
+        let ts = self.config.prediction.sample_time;
         let mut candidates: [(f64, usize); MAX_OBSTACLES] = [(f64::INFINITY, 0); MAX_OBSTACLES];
         let mut n = 0;
         for (k, o) in m.obstacles.iter().enumerate() {
             // Validated in `sample`.
             let Ok(Some(_)) = o.obstacle() else { continue };
-            let obstacle = mpc_obstacle(o);
+            let obstacle = mpc_obstacle(o, ts);
             let range = points
                 .iter()
                 .map(|&p| obstacle.distance(p).0)
@@ -525,7 +552,7 @@ impl Controller {
         candidates[..n].sort_by(|a, b| a.0.total_cmp(&b.0));
         let used = n.min(slots);
         for (j, &(_, k)) in candidates[..used].iter().enumerate() {
-            self.mpc_obstacles[j] = mpc_obstacle(&m.obstacles[k]);
+            self.mpc_obstacles[j] = mpc_obstacle(&m.obstacles[k], ts);
         }
         used
     }
@@ -557,8 +584,10 @@ fn finite_or(v: f64, default: f64) -> f64 {
 }
 
 /// The MPC's shape of an obstacle slot: a circle of radius `max(L, W) / 2`, or
-/// the ellipse with semi-axes `L / 2`, `W / 2` along the target's course.
-fn mpc_obstacle(o: &ObstacleInput) -> Obstacle {
+/// the ellipse with semi-axes `L / 2`, `W / 2` along the target's course,
+/// moving on at its course and speed over the horizon (`sample_time` s per
+/// sample).
+fn mpc_obstacle(o: &ObstacleInput, sample_time: f64) -> Obstacle {
     if o.kind == 1 {
         Obstacle::Circle {
             centre: [o.x, o.y],
@@ -570,6 +599,10 @@ fn mpc_obstacle(o: &ObstacleInput) -> Obstacle {
             semi_major: 0.5 * o.length,
             semi_minor: 0.5 * o.width.min(o.length),
             orientation: o.psi,
+            drift: [
+                o.speed * o.psi.cos() * sample_time,
+                o.speed * o.psi.sin() * sample_time,
+            ],
         }
     }
 }
@@ -578,7 +611,8 @@ fn mpc_obstacle(o: &ObstacleInput) -> Obstacle {
 struct SolveReport {
     iterations: usize,
     converged: bool,
-    failed: bool,
+    /// The first subproblem whose last QP solve failed, and how.
+    failed: Option<(&'static str, QpOutcome)>,
     r_pri: [f64; 2],
     r_dual: [f64; 2],
 }
@@ -598,7 +632,11 @@ impl Solver {
                 SolveReport {
                     iterations: r.iterations,
                     converged: r.converged,
-                    failed: r.last_step_failed(),
+                    failed: ["tug 1", "tug 2", "ship"]
+                        .into_iter()
+                        .zip(r.last_steps)
+                        .find(|(_, s)| !s.qp.is_usable())
+                        .map(|(name, s)| (name, s.qp)),
                     r_pri: r.r_pri,
                     r_dual: r.r_dual,
                 }
@@ -608,7 +646,7 @@ impl Solver {
                 SolveReport {
                     iterations: r.iterations,
                     converged: r.converged,
-                    failed: r.failed,
+                    failed: r.failed.then_some(("centralized", r.last_step.qp)),
                     // The consensus violation plays the primal residual's part.
                     r_pri: [r.breakdown.consensus_max; 2],
                     r_dual: [0.0; 2],
@@ -672,23 +710,13 @@ fn build_admm(
     ship_params: towing_mpc::ShipMpcParams,
     tug_params: towing_mpc::TugMpcParams,
 ) -> Result<Admm, ConfigError> {
-    use towing_mpc::{FormationMap, ShipMpc, TugModel, TugMpc};
-    let s = &config.scenario;
-    let err = |what: &str, e: String| ConfigError::new(what, e);
-    let ship = ShipMpc::new(
-        ShipModel::from_scenario(s, config.hull, config.prediction)
-            .map_err(|e| err("scenario.ship", e.to_string()))?,
-        FormationMap::from_scenario(s).map_err(|e| err("scenario", e.to_string()))?,
+    Admm::from_scenario_with(
+        &config.scenario,
+        config.hull,
+        config.prediction,
         ship_params,
+        tug_params,
+        config.admm,
     )
-    .map_err(|e| err("ship MPC", format!("{e:?}")))?;
-    let tug = |i: usize| -> Result<TugMpc, ConfigError> {
-        TugMpc::new(
-            TugModel::from_scenario(s, i, config.hull, config.prediction)
-                .map_err(|e| err("scenario.tug", e.to_string()))?,
-            tug_params,
-        )
-        .map_err(|e| err("tug MPC", format!("{e:?}")))
-    };
-    Admm::new(ship, [tug(0)?, tug(1)?], config.admm).map_err(|e| err(&e.field, e.reason))
+    .map_err(|e| ConfigError::new("distributed MPC", format!("{e:?}")))
 }

@@ -24,6 +24,8 @@ pub mod config;
 pub mod controller;
 pub mod error;
 
-pub use config::{Architecture, AvoidanceScheme, ControllerConfig, InnerLoopParams};
-pub use controller::{Command, Controller, Measurement, Prediction, SampleReport};
+pub use config::{
+    Architecture, AvoidanceScheme, ControllerConfig, InnerLoopParams, TrackingParams,
+};
+pub use controller::{Command, Controller, Fallback, Measurement, Prediction, SampleReport};
 pub use error::{ConfigError, MeasurementError};

@@ -175,8 +175,8 @@ fn scheme_three_tracks_the_unaltered_route_and_scheme_two_drops_the_distance_cos
     let run = |scheme| {
         let mut config = ControllerConfig::new(scenario.clone());
         config.scheme = scheme;
-        config.lookahead = 0.0;
-        config.los_distance = 0.0;
+        config.tracking.lookahead = 0.0;
+        config.tracking.los_distance = 0.0;
         let mut c = Controller::new(config).unwrap();
         c.sample(&m).unwrap()
     };
@@ -210,10 +210,10 @@ fn the_lookahead_point_lies_ahead_on_the_leg_and_the_heading_looks_at_it() {
 fn bad_configuration_values_are_named() {
     let (scenario, _) = paper_measurement();
     let mut config = ControllerConfig::new(scenario);
-    config.lookahead = -1.0;
+    config.tracking.lookahead = -1.0;
     let err = Controller::new(config.clone()).unwrap_err();
     assert_eq!(err.name, "lookahead");
-    config.lookahead = 3.0;
+    config.tracking.lookahead = 3.0;
     config.admm.max_iterations = 0;
     let err = Controller::new(config.clone()).unwrap_err();
     assert_eq!(err.name, "max_iterations");

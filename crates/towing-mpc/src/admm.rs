@@ -295,15 +295,35 @@ impl Admm {
         params: PredictionParams,
         settings: AdmmSettings,
     ) -> Result<Admm, AdmmBuildError> {
+        Admm::from_scenario_with(
+            scenario,
+            hull,
+            params,
+            ShipMpcParams::default(),
+            TugMpcParams::default(),
+            settings,
+        )
+    }
+
+    /// The loop for a scenario's vessels with the given subproblem parameters
+    /// (both tugs with `tug_params`).
+    pub fn from_scenario_with(
+        scenario: &Scenario,
+        hull: HullModel,
+        params: PredictionParams,
+        ship_params: ShipMpcParams,
+        tug_params: TugMpcParams,
+        settings: AdmmSettings,
+    ) -> Result<Admm, AdmmBuildError> {
         let ship = ShipMpc::new(
             ShipModel::from_scenario(scenario, hull, params)?,
             FormationMap::from_scenario(scenario)?,
-            ShipMpcParams::default(),
+            ship_params,
         )?;
         let tug = |i| -> Result<TugMpc, AdmmBuildError> {
             Ok(TugMpc::new(
                 TugModel::from_scenario(scenario, i, hull, params)?,
-                TugMpcParams::default(),
+                tug_params,
             )?)
         };
         Ok(Admm::new(ship, [tug(0)?, tug(1)?], settings)?)
@@ -514,4 +534,4 @@ fn never_run() -> ScpReport {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

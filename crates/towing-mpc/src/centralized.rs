@@ -81,7 +81,7 @@ use crate::scp::{
     QuadModel, ScpReport, ScpSettings, TrustRegion, SLACK_SCALE,
 };
 use crate::ship::{ShipInput, ShipLinearisation, ShipModel, ShipState};
-use crate::ship_mpc::ShipMpcParams;
+use crate::ship_mpc::{ship_stage_terms, ShipMpcParams};
 use crate::tug::{TowlinePull, TugInput, TugLinearisation, TugModel, TugState};
 use crate::tug_mpc::{rejected, TugMpcParams, HORIZON};
 
@@ -390,35 +390,16 @@ impl Problem {
             let rows = sens.map_or(zero, |s| sens_rows(&s.ship[h]));
             let x = &traj.ship[h];
             let r = input.reference[h];
-            let err = [x[0] - r[0], x[1] - r[1], angle_difference(x[2], r[2])];
-            // Velocity weights as in the coordination problem (yaw rate optionally
-            // weighted apart).
-            let wv = [
-                sp.weights[1],
-                sp.weights[1],
-                sp.yaw_rate_weight.unwrap_or(sp.weights[1]),
-            ];
-            for c in 0..3 {
-                quad.residual(err[c], sp.weights[0], 0.0, &rows[c]);
-                quad.residual(x[3 + c], wv[c], 0.0, &rows[3 + c]);
-            }
-            for (k, w) in [
-                sp.tension_weight,
-                sp.tension_weight,
-                sp.angle_weight,
-                sp.angle_weight,
-            ]
-            .into_iter()
-            .enumerate()
-            {
-                if w > 0.0 {
-                    let mut row = [0.0; NU];
-                    if with_rows {
-                        row[ship_var(h, k)] = 1.0;
-                    }
-                    quad.residual(plan.ship[h][k], w, 0.0, &row);
-                }
-            }
+            ship_stage_terms(
+                quad,
+                sp,
+                x,
+                r,
+                &plan.ship[h],
+                &rows,
+                with_rows.then(|| std::array::from_fn(|k| ship_var(h, k))),
+                h + 1 == HORIZON,
+            );
             obstacle_terms(
                 quad,
                 input.obstacles,

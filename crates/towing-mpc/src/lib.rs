@@ -110,7 +110,7 @@ pub use params::PredictionParams;
 pub use qp::{Qp, QpFailure, QpOutcome};
 pub use scp::{ClearanceParams, ScpReport, ScpSettings, TrustRegion};
 pub use ship::{ShipInput, ShipLinearisation, ShipModel, ShipState};
-pub use ship_mpc::{ShipMpc, ShipMpcParams, ShipStepData};
+pub use ship_mpc::{ShipMpc, ShipMpcParams, ShipStepData, TerminalCost};
 pub use tug::{TowlinePull, TugInput, TugLinearisation, TugModel, TugState};
 pub use tug_mpc::{TugMpc, TugMpcParams, TugStepData, HORIZON};
 

@@ -34,10 +34,41 @@ pub enum Obstacle {
         semi_minor: f64,
         /// Bearing of the major axis (rad, from North, clockwise).
         orientation: f64,
+        /// Displacement per control sample (m, NED): a target ship's velocity
+        /// times `T_s`. The prediction moves the ellipse by `(h + 1) drift` for
+        /// the state after sample `h` (constant course and speed, the
+        /// assumption of the paper's eq. (9) distances along the horizon);
+        /// zero for a stationary ellipse.
+        drift: [f64; 2],
     },
 }
 
 impl Obstacle {
+    /// The obstacle as predicted after `samples` control samples (ellipses move
+    /// by their `drift`; circles are static).
+    #[must_use]
+    pub fn after(&self, samples: usize) -> Obstacle {
+        match *self {
+            Obstacle::Ellipse {
+                centre,
+                semi_major,
+                semi_minor,
+                orientation,
+                drift,
+            } => {
+                let k = samples as f64;
+                Obstacle::Ellipse {
+                    centre: [centre[0] + k * drift[0], centre[1] + k * drift[1]],
+                    semi_major,
+                    semi_minor,
+                    orientation,
+                    drift,
+                }
+            }
+            circle @ Obstacle::Circle { .. } => circle,
+        }
+    }
+
     /// Distance `d` of the point `p` (module docs) and its gradient `dd/dp`.
     #[must_use]
     pub fn distance(&self, p: [f64; 2]) -> (f64, [f64; 2]) {
@@ -57,6 +88,7 @@ impl Obstacle {
                 semi_major,
                 semi_minor,
                 orientation,
+                ..
             } => {
                 let f = (semi_major * semi_major - semi_minor * semi_minor)
                     .max(0.0)
@@ -181,6 +213,7 @@ mod tests {
             semi_major: 2.0,
             semi_minor: 1.0,
             orientation: 0.0,
+            drift: [0.0; 2],
         };
         assert!((e.distance([3.0, 0.0]).0 - 1.0).abs() < 1e-12); // on the major axis
         assert!(e.distance([0.0, 1.0]).0.abs() < 1e-12); // on the ellipse

@@ -578,7 +578,8 @@ pub(crate) fn condense<const M: usize, const H: usize>(
     }
 }
 
-/// The obstacle terms of one predicted position `pos` (sample `h`) with
+/// The obstacle terms of one predicted position `pos` (the state after sample
+/// `h`; moving obstacles as predicted then, [`Obstacle::after`]) with
 /// `d(x, y)/du = (row_x, row_y)` (shared by the tug and ship problems): the
 /// distance cost `w phi(d)` of every obstacle and, for the first
 /// `params.max_obstacles`, the clearance penalty and (with `clearance`) the
@@ -597,7 +598,7 @@ pub(crate) fn obstacle_terms<const N: usize>(
     row_y: &[f64; N],
 ) {
     for (j, obstacle) in obstacles.iter().enumerate() {
-        let (d, grad) = obstacle.distance(pos);
+        let (d, grad) = obstacle.after(h + 1).distance(pos);
         let (phi, slope, curvature) = distance.eval(d);
         let mut row = [0.0; N];
         for (r, (a, b)) in row.iter_mut().zip(row_x.iter().zip(row_y)) {

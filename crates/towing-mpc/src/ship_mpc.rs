@@ -86,6 +86,8 @@ pub struct ShipMpcParams {
     /// picks the least tension among plans of (nearly) equal cost. 0 reproduces
     /// eq. (13) as printed.
     pub tension_weight: f64,
+    /// Optional terminal term, not in the paper (`docs/assumptions.md`).
+    pub terminal: Option<TerminalCost>,
     /// Trust-region scale of `(F, alpha)` (N, rad): the box is `radius * scale`.
     pub trust_scale: [f64; 2],
     /// Trust region.
@@ -106,14 +108,32 @@ impl Default for ShipMpcParams {
             max_angle: 30f64.to_radians(),
             tension_rate: 0.3,
             angle_rate: 5f64.to_radians(),
-            angle_weight: 0.5,
+            angle_weight: 0.0,
             tension_weight: 0.01,
+            terminal: Some(TerminalCost {
+                weight: 1.0,
+                horizon: 10.0,
+            }),
             trust_scale: [1.0, 0.2],
             scp: ScpSettings::default(),
             distance: DistanceCost::default(),
             clearance: ClearanceParams::with_min_distance(0.65),
         }
     }
+}
+
+/// A terminal term `w |e_H + tau eta_dot_H|^2` on the last predicted state: the
+/// pose error extrapolated `tau` seconds with the predicted velocity over
+/// ground. A 3 s horizon sees too little of a turn or an approach to start it
+/// (the gain comes after the horizon, the velocity cost within it); the
+/// extrapolation credits the velocity that is heading the right way (a
+/// cost-to-go approximation, e.g. Rawlings, Mayne, Diehl 2017, section 2.5).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TerminalCost {
+    /// `w` (per m^2 and per rad^2).
+    pub weight: f64,
+    /// `tau` (s).
+    pub horizon: f64,
 }
 
 /// The data of one step. Per sample `h`: `reference[h]`, `tug_poses[i][h]`,
@@ -427,6 +447,73 @@ impl ShipMpc {
     }
 }
 
+/// The ship's own terms of eq. (13) at one predicted state `x` (after sample
+/// `h`) reached with the sample's input `u`, shared by the coordination and the
+/// centralized problems: `w_S1 |eta - eta_d|^2` (heading wrapped), the velocity
+/// term (`w_S2`, the yaw rate optionally weighted apart), the optional
+/// regularisers of the tensions and angles and, on the last sample, the optional
+/// terminal term. `rows[c]` is `d x_c / du` over the QP's variables, `columns`
+/// the QP columns of `u` (`None`: value only).
+#[allow(clippy::too_many_arguments)] // the pieces of one stage; two call sites
+pub(crate) fn ship_stage_terms<const N: usize>(
+    quad: &mut QuadModel,
+    params: &ShipMpcParams,
+    x: &ShipState,
+    reference: [f64; 3],
+    u: &ShipInput,
+    rows: &[[f64; N]; 6],
+    columns: Option<[usize; 4]>,
+    last: bool,
+) {
+    let [w1, w2, _] = params.weights;
+    let err = [
+        x[0] - reference[0],
+        x[1] - reference[1],
+        angle_difference(x[2], reference[2]),
+    ];
+    let wv = [w2, w2, params.yaw_rate_weight.unwrap_or(w2)];
+    for c in 0..3 {
+        quad.residual(err[c], w1, 0.0, &rows[c]);
+        quad.residual(x[3 + c], wv[c], 0.0, &rows[3 + c]);
+    }
+    let wu = [
+        params.tension_weight,
+        params.tension_weight,
+        params.angle_weight,
+        params.angle_weight,
+    ];
+    for (k, w) in wu.into_iter().enumerate() {
+        if w > 0.0 {
+            let mut row = [0.0; N];
+            if let Some(cols) = columns {
+                row[cols[k]] = 1.0;
+            }
+            quad.residual(u[k], w, 0.0, &row);
+        }
+    }
+    if let (true, Some(t)) = (last, params.terminal) {
+        // The pose error extrapolated `tau` seconds with the predicted velocity
+        // over ground: e + tau eta_dot, eta_dot = R(psi) nu.
+        let (sn, cs) = x[2].sin_cos();
+        let xdot = [cs * x[3] - sn * x[4], sn * x[3] + cs * x[4], x[5]];
+        // d eta_dot / d(psi, u, v, r).
+        let d_psi = [-sn * x[3] - cs * x[4], cs * x[3] - sn * x[4], 0.0];
+        let d_nu = [[cs, -sn, 0.0], [sn, cs, 0.0], [0.0, 0.0, 1.0]];
+        for c in 0..3 {
+            let mut row = [0.0; N];
+            for (v, slot) in row.iter_mut().enumerate() {
+                *slot = rows[c][v]
+                    + t.horizon
+                        * (d_psi[c] * rows[2][v]
+                            + d_nu[c][0] * rows[3][v]
+                            + d_nu[c][1] * rows[4][v]
+                            + d_nu[c][2] * rows[5][v]);
+            }
+            quad.residual(err[c] + t.horizon * xdot[c], t.weight, 0.0, &row);
+        }
+    }
+}
+
 /// The cost terms of `states` (after samples 0..H) reached with `plan`; with
 /// `sens` the model rows too (and the clearance rows recorded).
 #[allow(clippy::too_many_arguments)] // one call site per use; a struct would only rename them
@@ -440,7 +527,7 @@ fn accumulate(
     mut clearance: Option<&mut Clearance>,
     data: &ShipStepData<'_>,
 ) {
-    let [w1, w2, w3] = params.weights;
+    let w3 = params.weights[2];
     let mut rows = [[0.0; N]; 6];
     for (h, x) in states.iter().enumerate() {
         if let Some(sens) = sens {
@@ -454,31 +541,17 @@ fn accumulate(
             }
         }
         let eta = [x[0], x[1], x[2]];
-        let r = data.reference[h];
-        let err = [x[0] - r[0], x[1] - r[1], angle_difference(x[2], r[2])];
-        for c in 0..3 {
-            quad.residual(err[c], w1, 0.0, &rows[c]);
-            let wv = if c == 2 {
-                params.yaw_rate_weight.unwrap_or(w2)
-            } else {
-                w2
-            };
-            quad.residual(x[3 + c], wv, 0.0, &rows[3 + c]);
-        }
-        for (k, w) in [
-            (0, params.tension_weight),
-            (1, params.tension_weight),
-            (2, params.angle_weight),
-            (3, params.angle_weight),
-        ] {
-            if w > 0.0 {
-                let mut row = [0.0; N];
-                if sens.is_some() {
-                    row[4 * h + k] = 1.0;
-                }
-                quad.residual(plan[h][k], w, 0.0, &row);
-            }
-        }
+        let columns = std::array::from_fn(|k| 4 * h + k);
+        ship_stage_terms(
+            quad,
+            params,
+            x,
+            data.reference[h],
+            &plan[h],
+            &rows,
+            sens.is_some().then_some(columns),
+            h + 1 == HORIZON,
+        );
         for i in 0..2 {
             let (f, jac) = formation.tug_reference_linearised(eta, plan[h][2 + i], i);
             let g = data.tug_poses[i][h];

@@ -5,30 +5,17 @@
 
 use fmi2_slave::ffi::Fmi2Status;
 use fmi2_slave::testing::{Exports, Fmu};
-use std::path::{Path, PathBuf};
 use towing_controller::variables::{self as vars, DESCRIPTION};
+pub use towing_interface::COMMANDS;
 use towing_model::Scenario;
 
 pub fn exports() -> Exports {
     fmi2_slave::exports_of!(towing_controller)
 }
 
-pub fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-/// The repository's `scenarios/` folder as a resource URI.
-pub fn resources_uri() -> String {
-    format!("file://{}", root().join("scenarios").display()).replace(' ', "%20")
-}
-
 /// A freshly instantiated controller (not initialized).
 pub fn controller(name: &str) -> Fmu {
-    Fmu::try_new(exports(), &DESCRIPTION, name, Some(&resources_uri()), false)
-        .unwrap_or_else(|log| panic!("instantiate failed: {log:?}"))
+    towing_interface::testing::instantiate(exports(), &DESCRIPTION, name)
 }
 
 /// The paper scenario's initial vessel states: `[vessel][x, y, psi, u, v, r]`.
@@ -59,7 +46,7 @@ pub fn set_states(fmu: &Fmu, states: &[[f64; 6]; 3]) {
 
 /// Sets obstacle slot `slot` (0-based): `[x, y, psi, speed, length, width]` and kind.
 pub fn set_obstacle(fmu: &Fmu, slot: u32, fields: [f64; 6], kind: i32) {
-    let vrs: Vec<u32> = (0..6).map(|j| vars::obstacle_input(slot, j)).collect();
+    let vrs: Vec<u32> = (0..6).map(|j| vars::obstacle(slot, j)).collect();
     assert_eq!(
         fmu.set_reals(&vrs, &fields),
         Fmi2Status::Ok,
@@ -67,7 +54,7 @@ pub fn set_obstacle(fmu: &Fmu, slot: u32, fields: [f64; 6], kind: i32) {
         fmu.log_text()
     );
     assert_eq!(
-        fmu.set_integer(vars::obstacle_input(slot, vars::OBSTACLE_KIND), kind),
+        fmu.set_integer(vars::obstacle(slot, vars::OBSTACLE_KIND), kind),
         Fmi2Status::Ok
     );
 }
@@ -79,18 +66,6 @@ pub fn initialized(name: &str) -> Fmu {
     fmu.init(0.0, None);
     fmu
 }
-
-/// The command outputs: tug1 X, Y, N, tug2 X, Y, N, tension 1, tension 2.
-pub const COMMANDS: [u32; 8] = [
-    vars::tug_force(0, 0),
-    vars::tug_force(0, 1),
-    vars::tug_force(0, 2),
-    vars::tug_force(1, 0),
-    vars::tug_force(1, 1),
-    vars::tug_force(1, 2),
-    vars::tension_cmd(0),
-    vars::tension_cmd(1),
-];
 
 pub fn commands(fmu: &Fmu) -> Vec<f64> {
     let (s, v) = fmu.try_get_reals(&COMMANDS);

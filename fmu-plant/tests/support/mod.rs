@@ -6,7 +6,6 @@
 use fmi2_slave::ffi::Fmi2Status;
 use fmi2_slave::testing::Fmu;
 use fmi2_slave::{Causality, ValueType};
-use std::path::Path;
 use towing_plant::variables::{self as vars, DESCRIPTION};
 
 /// A scenario with all 8 obstacle slots active from t = 0 (the towing-model bench's).
@@ -24,8 +23,7 @@ pub struct Bench {
 
 impl Bench {
     pub fn new() -> Bench {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
-        let scenario = root.join(EIGHT_OBSTACLES);
+        let scenario = towing_interface::testing::workspace_root().join(EIGHT_OBSTACLES);
         let fmu = Fmu::try_new(
             fmi2_slave::exports_of!(towing_plant),
             &DESCRIPTION,
@@ -42,7 +40,7 @@ impl Bench {
         fmu.init(0.0, None);
         for slot in 0..8 {
             assert_ne!(
-                fmu.get_integer(vars::obstacle_output(slot, vars::OBSTACLE_KIND)),
+                fmu.get_integer(vars::obstacle(slot, vars::OBSTACLE_KIND)),
                 0
             );
         }
@@ -78,16 +76,7 @@ impl Bench {
         Bench {
             fmu,
             inputs,
-            input_vrs: [
-                vars::tug_force(0, 0),
-                vars::tug_force(0, 1),
-                vars::tug_force(0, 2),
-                vars::tug_force(1, 0),
-                vars::tug_force(1, 1),
-                vars::tug_force(1, 2),
-                vars::tension_cmd(0),
-                vars::tension_cmd(1),
-            ],
+            input_vrs: towing_interface::COMMANDS,
             output_vrs,
             outputs: std::cell::RefCell::new(vec![0.0; n]),
             time: std::cell::Cell::new(0.0),

@@ -4,12 +4,23 @@ use towing_model::{HullModel, Scenario};
 
 use super::*;
 
+/// The coordination problem with the cost of eq. (13) as printed (no terminal
+/// term; the closed loop's default adds one, `docs/assumptions.md`).
+pub(crate) fn printed_cost() -> ShipMpcParams {
+    ShipMpcParams {
+        terminal: None,
+        ..ShipMpcParams::default()
+    }
+}
+
 fn admm(settings: AdmmSettings) -> Admm {
     let scenario = Scenario::paper().unwrap();
-    Admm::from_scenario(
+    Admm::from_scenario_with(
         &scenario,
         HullModel::NonlinearDamping,
         PredictionParams::default(),
+        printed_cost(),
+        TugMpcParams::default(),
         settings,
     )
     .unwrap()

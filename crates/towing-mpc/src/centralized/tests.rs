@@ -9,7 +9,7 @@ fn centralized(settings: CentralizedSettings) -> Centralized {
         &Scenario::paper().unwrap(),
         HullModel::NonlinearDamping,
         PredictionParams::default(),
-        ShipMpcParams::default(),
+        crate::admm::tests::printed_cost(),
         TugMpcParams::default(),
         settings,
     )
@@ -63,10 +63,12 @@ fn instances() -> [(&'static str, SampleInput<'static>); 3] {
 }
 
 fn tight_admm(rho: f64) -> Admm {
-    Admm::from_scenario(
+    Admm::from_scenario_with(
         &Scenario::paper().unwrap(),
         HullModel::NonlinearDamping,
         PredictionParams::default(),
+        crate::admm::tests::printed_cost(),
+        TugMpcParams::default(),
         AdmmSettings {
             rho,
             max_iterations: MAX_ITERATIONS,
@@ -208,7 +210,7 @@ fn compare_print() {
 /// commands.
 #[test]
 fn plans_respect_bounds_and_rates() {
-    let sp = ShipMpcParams::default();
+    let sp = crate::admm::tests::printed_cost();
     let tp = TugMpcParams::default();
     for (previous, d) in [
         ([3.5, -0.4, 0.7, -0.7], 0.0),
@@ -267,7 +269,7 @@ fn clearance_holds_near_an_obstacle() {
     let mut c = centralized(CentralizedSettings::default());
     let r = c.solve_sample(&input);
     assert!(!r.failed, "{r:?}");
-    let sp = ShipMpcParams::default();
+    let sp = crate::admm::tests::printed_cost();
     let tp = TugMpcParams::default();
     for x in c.ship_predicted() {
         let d = obstacles[0].distance([x[0], x[1]]).0;

@@ -1,0 +1,117 @@
+//! The interface contract both towing FMUs implement (DESIGN.md, "Interface contract";
+//! docs/interface.md): every variable a master connects by name is declared here once, with
+//! its name, value reference, unit, declared type and description, for both ends of the
+//! connection.
+//!
+//! * [`vr`]: the value references of the connected variables and of `scenario`, equal in
+//!   both FMUs.
+//! * [`variables`]: builders of those variables for one end of the connection
+//!   ([`Direction::Output`] in the FMU that computes them, [`Direction::Input`] in the one
+//!   that reads them), and the generic parameter/input/output builders.
+//! * [`types`]: the units and declared types, and the model-description skeleton
+//!   ([`ModelInfo`]).
+//! * [`scenario`]: the `scenario` String parameter (a file path, or the bundled
+//!   `resources/paper.toml`).
+//! * [`model_description_main`]: the body of each FMU's `model_description` binary.
+//! * `testing` (feature `testing`): in-process test helpers shared by the FMU crates.
+//!
+//! Who produces what: the plant (`TowingPlant`) outputs the vessel states, the towline
+//! values and the obstacle slots and reads the commands (tug forces, tension commands); the
+//! controller (`TowingController`) does the opposite.
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod scenario;
+pub mod types;
+pub mod variables;
+pub mod vr;
+
+#[cfg(feature = "testing")]
+pub mod testing;
+
+use fmi2_slave::description::ModelDescription;
+use std::io::Write as _;
+use std::process::ExitCode;
+
+pub use scenario::{ScenarioFile, BUNDLED_SCENARIO};
+pub use types::{ModelInfo, RealType};
+pub use variables::Direction;
+
+/// The vessels in value-reference order: name prefix and description.
+pub const VESSELS: [(&str, &str); 3] = [
+    ("ship", "ship (CyberShip II)"),
+    ("tug1", "aft tug (TitoNeri)"),
+    ("tug2", "forward tug (TitoNeri)"),
+];
+
+/// The command vector in the order masters and tests use it: tug1 surge force, sway force,
+/// yaw moment, tug2 the same, towline1 and towline2 tension commands.
+pub const COMMANDS: [u32; 8] = [
+    vr::tug_force(0, 0),
+    vr::tug_force(0, 1),
+    vr::tug_force(0, 2),
+    vr::tug_force(1, 0),
+    vr::tug_force(1, 1),
+    vr::tug_force(1, 2),
+    vr::tension_cmd(0),
+    vr::tension_cmd(1),
+];
+
+/// The names of DESIGN.md's interface contract every FMU declares: the commands, the vessel
+/// states, the towline values, the obstacle slots and `scenario`.
+#[must_use]
+pub fn contract_names() -> Vec<String> {
+    let mut names = vec![];
+    for tug in ["tug1", "tug2"] {
+        for f in ["force_surge", "force_sway", "moment_yaw"] {
+            names.push(format!("{tug}.{f}"));
+        }
+    }
+    for (vessel, _) in VESSELS {
+        for s in ["x", "y", "psi", "u", "v", "r"] {
+            names.push(format!("{vessel}.{s}"));
+        }
+    }
+    for line in ["towline1", "towline2"] {
+        for f in ["tension_cmd", "length", "angle", "tension"] {
+            names.push(format!("{line}.{f}"));
+        }
+    }
+    for k in 1..=towing_model::MAX_OBSTACLES {
+        for f in ["x", "y", "psi", "speed", "length", "width", "kind"] {
+            names.push(format!("obstacle[{k}].{f}"));
+        }
+    }
+    names.push("scenario".into());
+    names
+}
+
+/// The body of an FMU's `model_description` binary: prints `description` as
+/// `modelDescription.xml` (argument `xml` or none), as the Markdown variable table of
+/// docs/interface.md (`markdown`) or as HTML documentation (`html`); used by
+/// `cargo xtask model-description` and `cargo xtask fmu`. Exit code 2 for an unknown
+/// argument, 1 when stdout cannot be written.
+#[must_use]
+pub fn model_description_main(description: &ModelDescription) -> ExitCode {
+    let text = match std::env::args().nth(1).as_deref() {
+        Some("xml") | None => description.to_xml(),
+        Some("markdown") => fmi2_slave::doc::variables_markdown(description),
+        Some("html") => fmi2_slave::doc::documentation_html(description),
+        Some(other) => {
+            let _ = writeln!(
+                std::io::stderr(),
+                "unknown output {other:?}: use xml or html"
+            );
+            return ExitCode::from(2);
+        }
+    };
+    let mut out = std::io::stdout().lock();
+    if out
+        .write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .is_err()
+    {
+        return ExitCode::FAILURE;
+    }
+    ExitCode::SUCCESS
+}

@@ -1,0 +1,142 @@
+//! In-process test helpers shared by the FMU crates' tests (feature `testing`, enabled as a
+//! dev-dependency): instances on the repository's `scenarios/` folder, the checks of the
+//! committed model descriptions, and the abuse checks of the `scenario` parameter that both
+//! FMUs must pass.
+#![allow(clippy::missing_panics_doc, clippy::expect_used)]
+
+use fmi2_slave::description::ModelDescription;
+use fmi2_slave::ffi::Fmi2Status;
+use fmi2_slave::testing::{Exports, Fmu};
+use std::path::{Path, PathBuf};
+
+/// The repository (workspace) root.
+#[must_use]
+pub fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .canonicalize()
+        .expect("the workspace root exists")
+}
+
+/// The repository's `scenarios/` folder as a resource URI: it holds `paper.toml`, like the
+/// packaged FMU's `resources/`.
+#[must_use]
+pub fn resources_uri() -> String {
+    format!("file://{}", workspace_root().join("scenarios").display()).replace(' ', "%20")
+}
+
+/// A freshly instantiated FMU (not initialized) with [`resources_uri`] as its resources.
+#[must_use]
+pub fn instantiate(exports: Exports, description: &ModelDescription, name: &str) -> Fmu {
+    Fmu::try_new(exports, description, name, Some(&resources_uri()), false)
+        .unwrap_or_else(|log| panic!("instantiate failed: {log:?}"))
+}
+
+/// The last message `fmu` logged contains `needle` (all messages are shown when not).
+pub fn assert_last_message_contains(fmu: &Fmu, needle: &str) {
+    assert!(
+        fmu.last_text().contains(needle),
+        "last message lacks {needle:?}: {}",
+        fmu.log_text()
+    );
+}
+
+/// The text of the repository file `rel`.
+#[must_use]
+pub fn read_repository_file(rel: &str) -> String {
+    let path = workspace_root().join(rel);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// `description` is consistent (the checks `fmi2-slave` runs at instantiation).
+pub fn assert_description_is_consistent(description: &ModelDescription) {
+    if let Err(errors) = description.validate() {
+        panic!(
+            "{} is inconsistent: {errors:?}",
+            description.model_identifier
+        );
+    }
+}
+
+/// The committed `modelDescription/<modelIdentifier>.xml` is what `description` generates.
+pub fn assert_committed_model_description_matches(description: &ModelDescription) {
+    let rel = format!("modelDescription/{}.xml", description.model_identifier);
+    assert!(
+        read_repository_file(&rel) == description.to_xml(),
+        "{rel} is stale: run `cargo xtask model-description`"
+    );
+}
+
+/// docs/interface.md holds the variable table `description` generates.
+pub fn assert_interface_document_lists_the_variables(description: &ModelDescription) {
+    let doc = read_repository_file("docs/interface.md");
+    let table = fmi2_slave::doc::variables_markdown(description);
+    assert!(
+        doc.contains(&table),
+        "docs/interface.md does not hold the current {} table: run `cargo xtask model-description`",
+        description.model_identifier
+    );
+}
+
+/// Every name of DESIGN.md's contract ([`contract_names`](crate::contract_names)) is
+/// declared.
+pub fn assert_contract_names_are_declared(description: &ModelDescription) {
+    for name in crate::contract_names() {
+        assert!(
+            description.variables.iter().any(|v| v.name == name),
+            "missing contract variable {name}"
+        );
+    }
+}
+
+/// Without a resources folder and with an empty `scenario`, entering initialization is
+/// refused with a message saying to set `scenario`.
+pub fn assert_no_resources_and_no_scenario_is_refused(
+    exports: Exports,
+    description: &ModelDescription,
+) {
+    let fmu = Fmu::try_new(exports, description, "bare", None, false)
+        .unwrap_or_else(|log| panic!("instantiate failed: {log:?}"));
+    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
+    assert_eq!(fmu.enter_init(), Fmi2Status::Error);
+    assert_last_message_contains(&fmu, "set scenario");
+}
+
+/// A `scenario` naming a file that does not exist is refused at initialization with a
+/// message naming the file.
+pub fn assert_missing_scenario_file_is_named(exports: Exports, description: &ModelDescription) {
+    let missing = "/nonexistent/dir/s.toml";
+    let fmu = instantiate(exports, description, "missing");
+    assert_eq!(fmu.set_string(crate::vr::SCENARIO, missing), Fmi2Status::Ok);
+    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
+    assert_eq!(fmu.enter_init(), Fmi2Status::Error);
+    assert_last_message_contains(&fmu, missing);
+}
+
+/// The model-description tests of an FMU crate, on the `static` [`ModelDescription`]
+/// `$description`: consistent, equal to the committed `modelDescription/<id>.xml`, its
+/// variable table in docs/interface.md, and every contract name declared.
+#[macro_export]
+macro_rules! model_description_tests {
+    ($description:expr) => {
+        #[test]
+        fn description_is_consistent() {
+            $crate::testing::assert_description_is_consistent(&$description);
+        }
+
+        #[test]
+        fn committed_model_description_matches_the_variable_table() {
+            $crate::testing::assert_committed_model_description_matches(&$description);
+        }
+
+        #[test]
+        fn interface_document_lists_the_generated_variable_table() {
+            $crate::testing::assert_interface_document_lists_the_variables(&$description);
+        }
+
+        #[test]
+        fn contract_names_of_design_md_are_present() {
+            $crate::testing::assert_contract_names_are_declared(&$description);
+        }
+    };
+}

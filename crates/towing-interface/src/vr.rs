@@ -1,0 +1,44 @@
+//! Value references of the connected variables, the same in both FMUs (unique per FMI base
+//! type):
+//!
+//! | range | what |
+//! |---|---|
+//! | 1 | `scenario` (String parameter); other parameters are each FMU's own, below 100 |
+//! | 100 + 10 vessel + c | vessel states (ship 100.., tug1 110.., tug2 120..; c: x, y, psi, u, v, r) |
+//! | 200 + 10 tug + c, 220 + line | commands: tug forces (tug1 200.., tug2 210..), tension commands |
+//! | 300 + 10 line + field | towline values (towline1 300.., towline2 310..) |
+//! | 1000 + 10 (k - 1) + j | obstacle slot k = 1..=8, field j |
+
+/// `scenario` (String parameter): path of the scenario file; empty = bundled paper scenario.
+pub const SCENARIO: u32 = 1;
+
+/// Vessel state: vessel 0 ship, 1 tug1, 2 tug2; component 0..6 = x, y, psi, u, v, r.
+pub const fn vessel_state(vessel: u32, component: u32) -> u32 {
+    100 + 10 * vessel + component
+}
+
+/// Tug force command: tug 0 (tug1) or 1 (tug2); component 0 surge force, 1 sway force,
+/// 2 yaw moment.
+pub const fn tug_force(tug: u32, component: u32) -> u32 {
+    200 + 10 * tug + component
+}
+
+/// Tension command of towline 0 (towline1) or 1 (towline2).
+pub const fn tension_cmd(line: u32) -> u32 {
+    220 + line
+}
+
+/// Towline value of line 0 or 1: field 0 length, 1 angle, 2 tension, 3 slack (Boolean,
+/// plant only).
+pub const fn towline(line: u32, field: u32) -> u32 {
+    300 + 10 * line + field
+}
+
+/// Obstacle slot value, `slot` 0-based; field index into
+/// [`OBSTACLE_FIELDS`](crate::variables::OBSTACLE_FIELDS), or [`OBSTACLE_KIND`].
+pub const fn obstacle(slot: u32, field: u32) -> u32 {
+    1000 + 10 * slot + field
+}
+
+/// Field index of the Integer `obstacle[k].kind` within a slot.
+pub const OBSTACLE_KIND: u32 = 6;
