@@ -226,8 +226,8 @@ fn every_kind_of_bad_scenario_is_refused_naming_file_field_and_reason() {
         (
             "NaN value",
             edited_paper(
-                "speed = 0.07\nactivation_time = 405.0",
-                "speed = nan\nactivation_time = 405.0",
+                "speed = 0.07\nactivation_range = 14.2",
+                "speed = nan\nactivation_range = 14.2",
             ),
             "obstacles[4].speed",
             "finite",
@@ -241,11 +241,17 @@ fn every_kind_of_bad_scenario_is_refused_naming_file_field_and_reason() {
         (
             "negative speed",
             edited_paper(
-                "speed = 0.07\nactivation_time = 590.0",
-                "speed = -0.07\nactivation_time = 590.0",
+                "speed = 0.07\nactivation_range = 19.8",
+                "speed = -0.07\nactivation_range = 19.8",
             ),
             "obstacles[5].speed",
             ">= 0",
+        ),
+        (
+            "non-positive activation range",
+            edited_paper("activation_range = 19.8", "activation_range = 0.0"),
+            "obstacles[5].activation_range",
+            "> 0",
         ),
         (
             "too many obstacles",

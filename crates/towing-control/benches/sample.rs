@@ -16,9 +16,8 @@ const STEP: f64 = 0.1;
 const WINDOW: (f64, f64) = (100.0, 200.0);
 
 fn measure(world: &World) -> Measurement {
-    let v = |s: &towing_model::VesselState| {
-        [s.eta[0], s.eta[1], s.eta[2], s.nu[0], s.nu[1], s.nu[2]]
-    };
+    let v =
+        |s: &towing_model::VesselState| [s.eta[0], s.eta[1], s.eta[2], s.nu[0], s.nu[1], s.nu[2]];
     let mut m = Measurement {
         ship: v(world.ship()),
         tugs: [v(world.tug(0)), v(world.tug(1))],
@@ -89,8 +88,14 @@ impl Loop {
 
 fn bench(c: &mut Criterion) {
     for (name, arch) in [
-        ("sample_near_encounter_distributed", Architecture::Distributed),
-        ("sample_near_encounter_centralized", Architecture::Centralized),
+        (
+            "sample_near_encounter_distributed",
+            Architecture::Distributed,
+        ),
+        (
+            "sample_near_encounter_centralized",
+            Architecture::Centralized,
+        ),
     ] {
         let mut l = Loop::new(arch);
         c.bench_function(name, |b| {

@@ -141,11 +141,11 @@ pub struct TrackingParams {
 }
 
 impl Default for TrackingParams {
-    /// `lookahead = 3 m`, `los_distance = 2.5 m` (two CyberShip II lengths);
+    /// `lookahead = 3.5 m`, `los_distance = 2.5 m` (two CyberShip II lengths);
     /// why in `docs/assumptions.md`.
     fn default() -> Self {
         TrackingParams {
-            lookahead: 3.0,
+            lookahead: 3.5,
             los_distance: 2.5,
         }
     }

@@ -195,9 +195,10 @@ fn the_lookahead_point_lies_ahead_on_the_leg_and_the_heading_looks_at_it() {
     let (scenario, m) = paper_measurement();
     let mut c = Controller::new(ControllerConfig::new(scenario.clone())).unwrap();
     let r = c.sample(&m).unwrap();
-    // At the origin, on the route: 3 m along the first leg (course 101.3 deg).
+    // At the origin, on the route: `lookahead` along the first leg (course 101.3 deg).
     let course = (14.0f64 - 7.0).atan2(-6.3 + 4.9);
-    let expect = [-4.9 + 3.0 * course.cos(), 7.0 + 3.0 * course.sin()];
+    let ahead = ControllerConfig::new(scenario.clone()).tracking.lookahead;
+    let expect = [-4.9 + ahead * course.cos(), 7.0 + ahead * course.sin()];
     assert!(
         (r.reference[0] - expect[0]).abs() < 1e-9 && (r.reference[1] - expect[1]).abs() < 1e-9,
         "{:?}",

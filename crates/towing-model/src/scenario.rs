@@ -475,6 +475,7 @@ struct FileObstacle {
     course_deg: Option<f64>,
     speed: Option<f64>,
     activation_time: Option<f64>,
+    activation_range: Option<f64>,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize)]
@@ -792,11 +793,19 @@ fn convert(file: FileScenario, origin: &str) -> Result<Scenario, ScenarioError> 
             ("course_deg", o.course_deg),
             ("speed", o.speed),
             ("activation_time", o.activation_time),
+            ("activation_range", o.activation_range),
         ];
         let (required, forbidden, kind): (&[&str], &[&str], &str) = match o.kind {
             FileObstacleKind::Static => (
                 &["diameter"],
-                &["length", "width", "course_deg", "speed", "activation_time"],
+                &[
+                    "length",
+                    "width",
+                    "course_deg",
+                    "speed",
+                    "activation_time",
+                    "activation_range",
+                ],
                 "static",
             ),
             FileObstacleKind::Ship => (
@@ -828,6 +837,20 @@ fn convert(file: FileScenario, origin: &str) -> Result<Scenario, ScenarioError> 
                 ));
             }
         }
+        // The file's time must be finite (`inf` is how the model says "never by
+        // time", which the file says by omitting `activation_time`).
+        if let Some(t) = o.activation_time.filter(|t| t.is_infinite()) {
+            return Err(ScenarioError::invalid(
+                origin,
+                ParamError::new(
+                    format!("{path}.activation_time"),
+                    format!(
+                        "must be finite, got {t} (omit it and give `activation_range` for a target \
+                         that only the range activates)"
+                    ),
+                ),
+            ));
+        }
         let shape = match o.kind {
             FileObstacleKind::Static => ObstacleShape::Circle {
                 diameter: o.diameter.unwrap_or_default(),
@@ -837,7 +860,13 @@ fn convert(file: FileScenario, origin: &str) -> Result<Scenario, ScenarioError> 
                 width: o.width.unwrap_or_default(),
                 course: wrap_angle_keep_nan(o.course_deg.unwrap_or_default().to_radians()),
                 speed: o.speed.unwrap_or_default(),
-                activation_time: o.activation_time.unwrap_or(0.0),
+                // Neither trigger given: from t = 0; range only: never by time.
+                activation_time: match (o.activation_time, o.activation_range) {
+                    (Some(t), _) => t,
+                    (None, Some(_)) => f64::INFINITY,
+                    (None, None) => 0.0,
+                },
+                activation_range: o.activation_range,
             },
         };
         obstacles.push(Obstacle {

@@ -7,6 +7,12 @@
 //! for `t >= t_a`. Before `t_a` it does not exist: it reports its spawn position
 //! and size with kind 0 and speed 0 (see `paper/NOTES.md` section 2 for why the
 //! paper's targets B and C need a late activation).
+//!
+//! A target is activated by time (`activation_time`, known in advance) or by
+//! range (`activation_range`: the ship came that close to the spawn position),
+//! whichever comes first. Range activation depends on the run, so its time is
+//! dynamic state kept by [`crate::World`]; [`Obstacle::output_activated`] takes the
+//! effective activation time, [`Obstacle::output_at`] uses the time trigger only.
 
 use crate::vessel::ParamError;
 
@@ -35,8 +41,14 @@ pub enum ObstacleShape {
         course: f64,
         /// Speed over ground (m/s, >= 0).
         speed: f64,
-        /// Time at which it appears and starts moving (s, >= 0).
+        /// Time at which it appears and starts moving unless the range trigger
+        /// fired earlier (s, >= 0; `f64::INFINITY`: never by time, only with an
+        /// `activation_range`).
         activation_time: f64,
+        /// Range trigger (m, > 0): it appears at the end of the first
+        /// communication step (or at `t = 0`) at which the ship's centre is within
+        /// this distance of the spawn position `(x, y)`; `None`: time only.
+        activation_range: Option<f64>,
     },
 }
 
@@ -86,7 +98,9 @@ impl ObstacleOutput {
 }
 
 impl Obstacle {
-    /// True when the obstacle exists at time `t` (static: always; ship: `t >= t_a`).
+    /// True when the obstacle exists at time `t` by the time trigger alone
+    /// (static: always; ship: `t >= activation_time`). Range activation is not
+    /// known here; see [`crate::World::activation_time`].
     #[must_use]
     pub fn is_active(&self, t: f64) -> bool {
         match self.shape {
@@ -97,9 +111,45 @@ impl Obstacle {
         }
     }
 
-    /// State at time `t` (s), exact.
+    /// The time trigger of a target ship (s; `f64::INFINITY` when only the range
+    /// triggers it); `None` for a static obstacle.
+    #[must_use]
+    pub fn activation_time(&self) -> Option<f64> {
+        match self.shape {
+            ObstacleShape::Circle { .. } => None,
+            ObstacleShape::Vessel {
+                activation_time, ..
+            } => Some(activation_time),
+        }
+    }
+
+    /// The range trigger of a target ship (m); `None` for a static obstacle or a
+    /// target activated by time only.
+    #[must_use]
+    pub fn activation_range(&self) -> Option<f64> {
+        match self.shape {
+            ObstacleShape::Circle { .. } => None,
+            ObstacleShape::Vessel {
+                activation_range, ..
+            } => activation_range,
+        }
+    }
+
+    /// State at time `t` (s), exact, with the time trigger only (as if the range
+    /// trigger never fired).
     #[must_use]
     pub fn output_at(&self, t: f64) -> ObstacleOutput {
+        let by_time = self.activation_time().filter(|&t_a| t >= t_a);
+        self.output_activated(t, by_time)
+    }
+
+    /// State at time `t` (s), exact, of an obstacle whose effective activation
+    /// time is `activated_at` (`None`: not activated yet). A target ship exists
+    /// when `activated_at = Some(t_a)` with `t >= t_a` and is then at
+    /// `(x, y) + speed (t - t_a) (cos, sin)(course)`. Static obstacles ignore
+    /// `activated_at`.
+    #[must_use]
+    pub fn output_activated(&self, t: f64, activated_at: Option<f64>) -> ObstacleOutput {
         match self.shape {
             ObstacleShape::Circle { diameter } => ObstacleOutput {
                 x: self.x,
@@ -115,10 +165,10 @@ impl Obstacle {
                 width,
                 course,
                 speed,
-                activation_time,
+                ..
             } => {
-                if t >= activation_time {
-                    let run = speed * (t - activation_time);
+                if let Some(t_a) = activated_at.filter(|&t_a| t >= t_a) {
+                    let run = speed * (t - t_a);
                     let (s, c) = course.sin_cos();
                     ObstacleOutput {
                         x: self.x + run * c,
@@ -146,7 +196,8 @@ impl Obstacle {
 
     /// Checks the values (paths relative to the obstacle, as in the scenario file):
     /// finite position, diameter / length / width > 0, width <= length, course
-    /// finite, speed >= 0, activation time >= 0.
+    /// finite, speed >= 0, activation time finite and >= 0 (or `+inf` together
+    /// with an activation range), activation range finite and > 0.
     pub fn validate(&self) -> Result<(), ParamError> {
         use crate::vessel::{check_finite, check_non_negative, check_positive};
         if self.name.trim().is_empty() {
@@ -162,6 +213,7 @@ impl Obstacle {
                 course,
                 speed,
                 activation_time,
+                activation_range,
             } => {
                 check_positive("length", length, "m")?;
                 check_positive("width", width, "m")?;
@@ -175,7 +227,13 @@ impl Obstacle {
                 }
                 check_finite("course_deg", course)?;
                 check_non_negative("speed", speed, "m/s")?;
-                check_non_negative("activation_time", activation_time, "s")?;
+                if let Some(range) = activation_range {
+                    check_positive("activation_range", range, "m")?;
+                }
+                // +inf is "never by time": allowed only when the range triggers it.
+                if !(activation_time == f64::INFINITY && activation_range.is_some()) {
+                    check_non_negative("activation_time", activation_time, "s")?;
+                }
             }
         }
         Ok(())
@@ -197,7 +255,71 @@ mod tests {
                 course: 0.0,
                 speed: 0.07,
                 activation_time,
+                activation_range: None,
             },
+        }
+    }
+
+    fn set_triggers(o: &mut Obstacle, time: f64, range: Option<f64>) {
+        if let ObstacleShape::Vessel {
+            activation_time,
+            activation_range,
+            ..
+        } = &mut o.shape
+        {
+            *activation_time = time;
+            *activation_range = range;
+        }
+    }
+
+    #[test]
+    fn output_activated_moves_from_the_given_activation_time() {
+        // Range-only target: never active by time, active from whatever time the
+        // world says it was activated.
+        let mut b = target(0.0);
+        set_triggers(&mut b, f64::INFINITY, Some(14.0));
+        assert_eq!(b.output_at(1e6).kind, KIND_NONE);
+        assert!(!b.is_active(1e6));
+        assert_eq!(b.output_activated(500.0, None).kind, KIND_NONE);
+        // Not yet at 399 s when activated at 400 s.
+        assert_eq!(b.output_activated(399.0, Some(400.0)).kind, KIND_NONE);
+        let at = b.output_activated(400.0, Some(400.0));
+        assert_eq!(
+            (at.kind, at.x, at.y, at.speed),
+            (KIND_VESSEL, -22.0, 40.75, 0.07)
+        );
+        let later = b.output_activated(500.0, Some(400.0));
+        assert!((later.x - (-22.0 + 7.0)).abs() < 1e-12);
+        assert_eq!(b.activation_time(), Some(f64::INFINITY));
+        assert_eq!(b.activation_range(), Some(14.0));
+    }
+
+    #[test]
+    fn activation_range_validation() {
+        for (time, range, ok) in [
+            (f64::INFINITY, Some(14.0), true),
+            (5.0, Some(14.0), true),
+            (f64::INFINITY, None, false),
+            (f64::NAN, Some(14.0), false),
+            (0.0, Some(0.0), false),
+            (0.0, Some(-1.0), false),
+            (0.0, Some(f64::INFINITY), false),
+            (0.0, Some(f64::NAN), false),
+        ] {
+            let mut o = target(0.0);
+            set_triggers(&mut o, time, range);
+            match o.validate() {
+                Ok(()) => assert!(ok, "{time} {range:?} accepted"),
+                Err(e) => {
+                    assert!(!ok, "{time} {range:?} refused: {e:?}");
+                    let field = if range.is_some_and(|r| !(r.is_finite() && r > 0.0)) {
+                        "activation_range"
+                    } else {
+                        "activation_time"
+                    };
+                    assert_eq!(e.field, field);
+                }
+            }
         }
     }
 

@@ -24,6 +24,15 @@
 //! world is unchanged (the plant FMU reports `fmi2Discard`). A step allocates
 //! nothing.
 //!
+//! Traffic: target ships activated by time move analytically from their
+//! `activation_time`, exactly, even when it falls inside a step. Target ships
+//! with an `activation_range` are also checked at `t = 0` and at the end of
+//! every step: the first time the ship's centre (its body origin CO) is within
+//! the range of the spawn position, the target appears there with that time as
+//! its activation time, unless the time trigger came first. The effective
+//! activation times are dynamic state ([`World::activation_time`], saved by
+//! [`World::write_state`]).
+//!
 //! The hulls' kinetics are [`HullDynamics`] trait objects, one per vessel, boxed
 //! once at construction: [`World::new`] builds the built-in model that
 //! [`WorldConfig::hull_model`] selects, [`World::with_hulls`] takes your own (see
@@ -180,9 +189,9 @@ const STATE_NAMES: [&str; NX] = [
 ];
 
 const STATE_MAGIC: &[u8; 8] = b"TOWWORLD";
-const STATE_VERSION: u32 = 1;
+const STATE_VERSION: u32 = 2;
 /// Size of [`World::write_state`]'s output (bytes).
-pub const STATE_BYTES: usize = 8 + 4 + 8 + 8 * (1 + 18 + 2 + 2) + 2;
+pub const STATE_BYTES: usize = 8 + 4 + 8 + 8 * (1 + 18 + 2 + 2) + 2 + 8 * MAX_OBSTACLES;
 
 /// Ship, tugs, towlines and traffic. See the module docs.
 #[derive(Debug, Clone)]
@@ -205,6 +214,10 @@ pub struct World {
     l0: [f64; 2],
     tension: [f64; 2],
     slack: [bool; 2],
+    /// Effective activation time of each target-ship slot (s), once activated by
+    /// time or range; `None` before, and always for static obstacles and empty
+    /// slots.
+    activated_at: [Option<f64>; MAX_OBSTACLES],
 }
 
 impl World {
@@ -291,6 +304,7 @@ impl World {
             l0: [0.0; 2],
             tension: [0.0; 2],
             slack: [true; 2],
+            activated_at: [None; MAX_OBSTACLES],
         };
         if world.elastic.is_some() {
             for line in 0..2 {
@@ -298,7 +312,58 @@ impl World {
             }
         }
         world.fingerprint = world.compute_fingerprint();
+        world.update_activations();
         world
+    }
+
+    /// Records the targets that become active at [`World::time`]: by time if
+    /// `activation_time <= time` (with `activation_time` itself, so the motion
+    /// stays exact), else by range if the ship's centre is within
+    /// `activation_range` of the spawn position (with the current time).
+    fn update_activations(&mut self) {
+        let [x, y, _] = self.vessels[0].eta;
+        for (slot, o) in self.obstacles.iter().enumerate() {
+            if self.activated_at[slot].is_some() {
+                continue;
+            }
+            let ObstacleShape::Vessel {
+                activation_time,
+                activation_range,
+                ..
+            } = o.shape
+            else {
+                continue;
+            };
+            if activation_time <= self.time {
+                self.activated_at[slot] = Some(activation_time);
+            } else if activation_range.is_some_and(|r| (o.x - x).hypot(o.y - y) <= r) {
+                self.activated_at[slot] = Some(self.time);
+            }
+        }
+    }
+
+    /// Effective activation time (s) of the target ship in obstacle slot `slot`:
+    /// its `activation_time` once that has passed, or the end of the step at which
+    /// the ship came within its `activation_range`, whichever was first. `None`
+    /// while it is not active, and for static obstacles and empty slots.
+    ///
+    /// # Panics
+    /// If `slot >= MAX_OBSTACLES`.
+    #[must_use]
+    pub fn activation_time(&self, slot: usize) -> Option<f64> {
+        assert!(
+            slot < MAX_OBSTACLES,
+            "obstacle slot {slot} out of range (0..{MAX_OBSTACLES})"
+        );
+        let by_time = self
+            .obstacles
+            .get(slot)
+            .and_then(Obstacle::activation_time)
+            .filter(|&t_a| self.time >= t_a);
+        match (by_time, self.activated_at[slot]) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
     }
 
     /// Simulation time (s): the sum of all committed step sizes.
@@ -413,8 +478,9 @@ impl World {
         self.elastic.map(|_| self.l0[i])
     }
 
-    /// Obstacle slot `slot` (0..[`MAX_OBSTACLES`]) at [`World::time`]; slots beyond
-    /// the scenario's obstacles are [`ObstacleOutput::EMPTY`].
+    /// Obstacle slot `slot` (0..[`MAX_OBSTACLES`]) at [`World::time`], with the
+    /// effective activation ([`World::activation_time`]); slots beyond the
+    /// scenario's obstacles are [`ObstacleOutput::EMPTY`].
     ///
     /// # Panics
     /// If `slot >= MAX_OBSTACLES`.
@@ -424,9 +490,9 @@ impl World {
             slot < MAX_OBSTACLES,
             "obstacle slot {slot} out of range (0..{MAX_OBSTACLES})"
         );
-        self.obstacles
-            .get(slot)
-            .map_or(ObstacleOutput::EMPTY, |o| o.output_at(self.time))
+        self.obstacles.get(slot).map_or(ObstacleOutput::EMPTY, |o| {
+            o.output_activated(self.time, self.activation_time(slot))
+        })
     }
 
     fn line_geometry(&self, line: usize) -> towline::LineGeometry {
@@ -523,6 +589,7 @@ impl World {
             self.tension[line] = t;
             self.slack[line] = t <= 0.0;
         }
+        self.update_activations();
         Ok(())
     }
 
@@ -599,14 +666,18 @@ impl World {
     }
 
     /// Writes the dynamic state (time, the three vessels, the elastic lines'
-    /// paid-out lengths, the applied tensions and slack flags) as versioned
-    /// little-endian bytes, replacing `out`'s content. Layout (version 1):
+    /// paid-out lengths, the applied tensions and slack flags, the targets'
+    /// activation times) as versioned little-endian bytes, replacing `out`'s
+    /// content. Layout (version 2):
     /// `b"TOWWORLD"`, `u32` version, `u64` fingerprint of the world's parameters,
     /// `f64` time, 3 x `[x, y, psi, u, v, r]` (ship, tug 1, tug 2), `f64 l0[2]`,
-    /// `f64 tension[2]`, `u8 slack[2]`; [`STATE_BYTES`] bytes in all.
+    /// `f64 tension[2]`, `u8 slack[2]`, `f64 activated_at[MAX_OBSTACLES]` (effective
+    /// activation time per obstacle slot, NaN = not activated); [`STATE_BYTES`]
+    /// bytes in all. Version 1 lacked `activated_at`.
     ///
     /// The fingerprint (FNV-1a) covers the configuration (including the
-    /// `hull_model` label), the three vessels' data, the obstacles and, per hull,
+    /// `hull_model` label), the three vessels' data, the obstacles (including
+    /// their `activation_time` and `activation_range`) and, per hull,
     /// its mass matrix and its `D(nu)` and `nu_dot(nu, tau)` at a fixed set of
     /// reference points (so it also tells apart user hulls from
     /// [`World::with_hulls`] that differ in `C`, `D` or `M^-1`). It is a check
@@ -628,6 +699,9 @@ impl World {
         }
         for s in self.slack {
             out.push(u8::from(s));
+        }
+        for a in self.activated_at {
+            out.extend_from_slice(&a.unwrap_or(f64::NAN).to_le_bytes());
         }
     }
 
@@ -680,6 +754,12 @@ impl World {
         }
         let tension = [read_f64(), read_f64()];
         let slack_bytes = [take(1)[0], take(1)[0]];
+        let mut activated_raw = [0.0; MAX_OBSTACLES];
+        for a in &mut activated_raw {
+            let mut w = [0u8; 8];
+            w.copy_from_slice(take(8));
+            *a = f64::from_le_bytes(w);
+        }
         if !time.is_finite() || time < 0.0 {
             return Err(format!("time {time} is not a finite value >= 0"));
         }
@@ -703,11 +783,35 @@ impl World {
         if slack_bytes.iter().any(|&b| b > 1) {
             return Err("slack flags must be 0 or 1".to_owned());
         }
+        let mut activated_at = [None; MAX_OBSTACLES];
+        for (slot, &a) in activated_raw.iter().enumerate() {
+            if a.is_nan() {
+                continue;
+            }
+            let is_target = matches!(
+                self.obstacles.get(slot).map(|o| o.shape),
+                Some(ObstacleShape::Vessel { .. })
+            );
+            if !is_target {
+                return Err(format!(
+                    "activated_at[{slot}] = {a}, but slot {slot} is not a target ship \
+                     (must be NaN, not activated)"
+                ));
+            }
+            if !(a.is_finite() && a >= 0.0 && a <= time) {
+                return Err(format!(
+                    "activated_at[{slot}] = {a} is neither NaN (not activated) nor a finite \
+                     time in [0, {time}] s"
+                ));
+            }
+            activated_at[slot] = Some(a);
+        }
         self.time = time;
         self.unpack(&x);
         self.l0 = [x[L0], x[L0 + 1]];
         self.tension = tension;
         self.slack = [slack_bytes[0] == 1, slack_bytes[1] == 1];
+        self.activated_at = activated_at;
         Ok(())
     }
 
@@ -768,9 +872,17 @@ impl World {
                     course,
                     speed,
                     activation_time,
+                    activation_range,
                 } => {
                     for v in [length, width, course, speed, activation_time] {
                         eat(&v.to_le_bytes());
+                    }
+                    match activation_range {
+                        None => eat(&[0]),
+                        Some(r) => {
+                            eat(&[1]);
+                            eat(&r.to_le_bytes());
+                        }
                     }
                 }
             }

@@ -117,7 +117,7 @@ impl Default for ShipMpcParams {
             trust_scale: [1.0, 0.2],
             scp: ScpSettings::default(),
             distance: DistanceCost::default(),
-            clearance: ClearanceParams::with_min_distance(0.65),
+            clearance: ClearanceParams::with_min_distance(0.75),
         }
     }
 }

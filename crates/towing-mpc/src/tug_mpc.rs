@@ -83,7 +83,7 @@ impl Default for TugMpcParams {
             trust_scale: [10.0; 3],
             scp: ScpSettings::default(),
             distance: DistanceCost::default(),
-            clearance: ClearanceParams::with_min_distance(0.5),
+            clearance: ClearanceParams::with_min_distance(0.6),
         }
     }
 }

@@ -103,18 +103,29 @@ fn paper_scenario_parses() {
     assert_eq!(s.obstacles.len(), 6);
     let names: Vec<&str> = s.obstacles.iter().map(|o| o.name.as_str()).collect();
     assert_eq!(names, ["a", "b", "c", "A", "B", "C"]);
-    let activation: Vec<f64> = s
+    // A by time from t = 0; B and C by range only (scenarios/paper.toml).
+    let triggers: Vec<(f64, Option<f64>)> = s
         .obstacles
         .iter()
         .filter_map(|o| match o.shape {
             ObstacleShape::Vessel {
-                activation_time, ..
-            } => Some(activation_time),
+                activation_time,
+                activation_range,
+                ..
+            } => Some((activation_time, activation_range)),
             ObstacleShape::Circle { .. } => None,
         })
         .collect();
-    assert_eq!(activation, [0.0, 405.0, 590.0]);
-    let b = s.obstacles[4].output_at(405.0 + 100.0);
+    assert_eq!(
+        triggers,
+        [
+            (0.0, None),
+            (f64::INFINITY, Some(14.2)),
+            (f64::INFINITY, Some(19.8))
+        ]
+    );
+    // Activated at 405 s (by range, in a world), B moves North from its spawn.
+    let b = s.obstacles[4].output_activated(405.0 + 100.0, Some(405.0));
     assert_eq!(b.kind, KIND_VESSEL);
     assert!((b.x - (-22.0 + 7.0)).abs() < 1e-12 && (b.y - 40.75).abs() < 1e-12);
     // The ship at the route origin, at rest.
@@ -752,6 +763,115 @@ fn refuses_negative_speed_and_activation_time() {
         ScenarioErrorKind::Invalid,
         "obstacles[0].activation_time",
         "must be >= 0 s",
+    );
+}
+
+/// The triggers of the one target of `MINIMAL` + `TARGET` after editing its
+/// `activation_time = 10.0` line into `lines`.
+fn triggers_with(lines: &str) -> Result<(f64, Option<f64>), ScenarioError> {
+    let text = format!(
+        "{MINIMAL}{}",
+        TARGET.replace("activation_time = 10.0\n", lines)
+    );
+    let s = parse(&text)?;
+    Ok((
+        s.obstacles[0].activation_time().unwrap(),
+        s.obstacles[0].activation_range(),
+    ))
+}
+
+#[test]
+fn activation_by_time_range_or_both() {
+    // Time only (as before), range only (never by time), both, neither (t = 0).
+    assert_eq!(
+        triggers_with("activation_time = 10.0\n").unwrap(),
+        (10.0, None)
+    );
+    assert_eq!(
+        triggers_with("activation_range = 12.5\n").unwrap(),
+        (f64::INFINITY, Some(12.5))
+    );
+    assert_eq!(
+        triggers_with("activation_time = 30.0\nactivation_range = 12\n").unwrap(),
+        (30.0, Some(12.0))
+    );
+    assert_eq!(triggers_with("").unwrap(), (0.0, None));
+}
+
+#[test]
+fn refuses_bad_activation_ranges_and_times() {
+    let text = |lines: &str| {
+        format!(
+            "{MINIMAL}{}",
+            TARGET.replace("activation_time = 10.0\n", lines)
+        )
+    };
+    for (lines, path, reason) in [
+        (
+            "activation_range = 0.0\n",
+            "obstacles[0].activation_range",
+            "must be > 0 m",
+        ),
+        (
+            "activation_range = -3.0\n",
+            "obstacles[0].activation_range",
+            "must be > 0 m",
+        ),
+        (
+            "activation_range = nan\n",
+            "obstacles[0].activation_range",
+            "must be finite",
+        ),
+        (
+            "activation_range = inf\n",
+            "obstacles[0].activation_range",
+            "must be finite",
+        ),
+        (
+            "activation_time = 5.0\nactivation_range = -1.0\n",
+            "obstacles[0].activation_range",
+            "must be > 0 m",
+        ),
+        (
+            "activation_time = inf\nactivation_range = 4.0\n",
+            "obstacles[0].activation_time",
+            "must be finite",
+        ),
+        (
+            "activation_time = nan\nactivation_range = 4.0\n",
+            "obstacles[0].activation_time",
+            "must be finite",
+        ),
+        (
+            "activation_time = -1.0\nactivation_range = 4.0\n",
+            "obstacles[0].activation_time",
+            "must be >= 0 s",
+        ),
+    ] {
+        let e = refused(&text(lines), ScenarioErrorKind::Invalid, path, reason);
+        // Located at the offending value's line.
+        let line = text(lines)
+            .lines()
+            .position(|l| l.starts_with(path.rsplit('.').next().unwrap()))
+            .unwrap()
+            + 1;
+        assert_eq!(e.location.map(|l| l.0), Some(line), "{lines}: {e}");
+    }
+    // Wrong type, and not allowed on a static obstacle.
+    refused(
+        &text("activation_range = \"near\"\n"),
+        ScenarioErrorKind::Schema,
+        "obstacles[0].activation_range",
+        "invalid type",
+    );
+    refused(
+        &format!(
+            "{MINIMAL}[[obstacles]]\nname = \"a\"\nkind = \"static\"\nx = 1.0\ny = 2.0\n\
+             diameter = 1.0\nactivation_range = 3.0\n"
+        ),
+        ScenarioErrorKind::Schema,
+        "obstacles[0].activation_range",
+        "not allowed for kind = \"static\"",
     );
 }
 

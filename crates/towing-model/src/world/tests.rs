@@ -981,3 +981,301 @@ fn with_hulls_refuses_hulls_that_break_the_documented_properties() {
 fn hull_index_beyond_the_tugs_panics() {
     let _ = world_with(BASE, WorldConfig::default()).hull(3);
 }
+
+// ---------------------------------------------------------------------------
+// Range activation of target ships.
+
+/// The forward tug pulls the tow North (ship from x = 0, accelerating at about
+/// 0.08 m/s^2).
+const PULL: WorldInputs = WorldInputs {
+    tug_tau: [[0.0; 3], [5.0, 0.0, 0.0]],
+    tension_cmd: [0.0, 2.0],
+};
+
+/// `BASE` with one target ship per `(x, y, trigger lines)`, all heading East at
+/// 0.1 m/s.
+fn with_targets(targets: &[(f64, f64, &str)]) -> String {
+    let mut text = BASE.to_owned();
+    for (i, (x, y, lines)) in targets.iter().enumerate() {
+        text.push_str(&format!(
+            "\n[[obstacles]]\nname = \"T{i}\"\nkind = \"ship\"\nx = {x:?}\ny = {y:?}\n\
+             length = 1.48\nwidth = 0.48\ncourse_deg = 90.0\nspeed = 0.1\n{lines}\n"
+        ));
+    }
+    text
+}
+
+fn ship_distance_to(w: &World, x: f64, y: f64) -> f64 {
+    (w.ship().eta[0] - x).hypot(w.ship().eta[1] - y)
+}
+
+/// Steps `PULL` until slot 0 is active; returns the world (at the activation
+/// step) and the number of steps.
+fn pull_until_active(text: &str) -> (World, usize) {
+    let mut w = world_with(text, WorldConfig::default());
+    for n in 1..=200 {
+        w.step(&PULL, 0.1).unwrap();
+        if w.activation_time(0).is_some() {
+            return (w, n);
+        }
+    }
+    panic!("slot 0 never activated");
+}
+
+#[test]
+fn range_target_activates_at_the_first_step_end_within_range_and_not_before() {
+    // Spawn 3.61 m from the ship's start; the range 3.2 m is reached when the
+    // ship has moved about 0.89 m North (after about 5 s).
+    let (sx, sy, range) = (2.0, 3.0, 3.2);
+    let text = with_targets(&[(sx, sy, "activation_range = 3.2")]);
+    let mut w = world_with(&text, WorldConfig::default());
+    assert!(ship_distance_to(&w, sx, sy) > range);
+    assert_eq!(w.obstacle(0).kind, KIND_NONE);
+    let mut steps = 0;
+    loop {
+        w.step(&PULL, 0.1).unwrap();
+        steps += 1;
+        let d = ship_distance_to(&w, sx, sy);
+        let o = w.obstacle(0);
+        if d > range {
+            // Not before: outside the range, nothing.
+            assert_eq!(w.activation_time(0), None, "step {steps}, d = {d}");
+            assert_eq!((o.kind, o.x, o.y, o.speed), (KIND_NONE, sx, sy, 0.0));
+            assert!(steps < 200, "never came within range");
+            continue;
+        }
+        // The first step end within range: active now, at the spawn position.
+        assert_eq!(w.activation_time(0), Some(w.time()));
+        assert_eq!((o.kind, o.x, o.y, o.speed), (KIND_VESSEL, sx, sy, 0.1));
+        break;
+    }
+    assert!((20..100).contains(&steps), "{steps}");
+    let t_a = w.time();
+    // Then it moves exactly from there, and stays active even when the ship
+    // leaves the range (here: the ship keeps going North, past it).
+    for _ in 0..300 {
+        w.step(&PULL, 0.1).unwrap();
+    }
+    assert!(ship_distance_to(&w, sx, sy) > range);
+    let o = w.obstacle(0);
+    assert_eq!(w.activation_time(0), Some(t_a));
+    assert_eq!(o.kind, KIND_VESSEL);
+    assert!((o.y - (sy + 0.1 * (w.time() - t_a))).abs() < 1e-12);
+    assert_eq!(o.x, sx);
+}
+
+#[test]
+fn range_target_within_range_at_the_start_is_active_from_t_0() {
+    let text = with_targets(&[(1.0, 1.0, "activation_range = 2.0")]);
+    let w = world_with(&text, WorldConfig::default());
+    assert_eq!(w.activation_time(0), Some(0.0));
+    assert_eq!(w.obstacle(0).kind, KIND_VESSEL);
+}
+
+#[test]
+fn range_target_far_away_never_activates() {
+    let text = with_targets(&[(200.0, 3.0, "activation_range = 3.2")]);
+    let mut w = world_with(&text, WorldConfig::default());
+    for _ in 0..300 {
+        w.step(&PULL, 0.1).unwrap();
+    }
+    assert_eq!(w.activation_time(0), None);
+    assert_eq!(w.obstacle(0).kind, KIND_NONE);
+}
+
+#[test]
+fn time_and_range_activate_whichever_comes_first() {
+    // When does the range alone trigger it?
+    let (_, n) = pull_until_active(&with_targets(&[(2.0, 3.0, "activation_range = 3.2")]));
+    let t_range = n as f64 * 0.1;
+    // Time first, inside the step that ends within range: exactly at the time.
+    let early = t_range - 0.05;
+    let text = with_targets(&[(
+        2.0,
+        3.0,
+        &format!("activation_range = 3.2\nactivation_time = {early:?}"),
+    )]);
+    let (w, m) = pull_until_active(&text);
+    assert_eq!(m, n);
+    assert_eq!(w.activation_time(0), Some(early));
+    let o = w.obstacle(0);
+    assert!((o.y - (3.0 + 0.1 * (w.time() - early))).abs() < 1e-12);
+    assert!(o.y > 3.0);
+    // Range first: at the step end, although the time comes a little later.
+    let late = t_range + 0.05;
+    let text = with_targets(&[(
+        2.0,
+        3.0,
+        &format!("activation_range = 3.2\nactivation_time = {late:?}"),
+    )]);
+    let (mut w, m) = pull_until_active(&text);
+    assert_eq!(m, n);
+    let t_a = w.activation_time(0).unwrap();
+    assert!((t_a - t_range).abs() < 1e-9, "{t_a} vs {t_range}");
+    assert_eq!((w.obstacle(0).x, w.obstacle(0).y), (2.0, 3.0));
+    // ... and the later time does not restart it.
+    w.step(&PULL, 0.1).unwrap();
+    assert_eq!(w.activation_time(0), Some(t_a));
+    assert!((w.obstacle(0).y - (3.0 + 0.1 * (w.time() - t_a))).abs() < 1e-12);
+    // Time only: unaffected by the ship's range.
+    let text = with_targets(&[(2.0, 3.0, &format!("activation_time = {late:?}"))]);
+    let (w, m) = pull_until_active(&text);
+    assert_eq!(m, n + 1);
+    assert_eq!(w.activation_time(0), Some(late));
+}
+
+#[test]
+fn activation_survives_write_and_read_state() {
+    let text = with_targets(&[
+        (2.0, 3.0, "activation_range = 3.2"),
+        (3.0, -3.0, "activation_range = 3.3"),
+    ]);
+    // Saved 10 steps in, before either target is active.
+    let mut a = world_with(&text, WorldConfig::default());
+    for _ in 0..10 {
+        a.step(&PULL, 0.1).unwrap();
+    }
+    assert_eq!((a.activation_time(0), a.activation_time(1)), (None, None));
+    let before = state_bytes(&a);
+    assert_eq!(before.len(), STATE_BYTES);
+    let mut trajectory = Vec::new();
+    for _ in 0..100 {
+        a.step(&PULL, 0.1).unwrap();
+        trajectory.push((state_bytes(&a), a.obstacle(0), a.obstacle(1)));
+    }
+    let t0 = a.activation_time(0).unwrap();
+    let t1 = a.activation_time(1).unwrap();
+    assert!(t1 > t0, "{t0} {t1}");
+    // A world restored from before the activation activates as the original did.
+    let mut b = world_with(&text, WorldConfig::default());
+    b.read_state(&before).unwrap();
+    for expected in &trajectory {
+        b.step(&PULL, 0.1).unwrap();
+        assert_eq!(&(state_bytes(&b), b.obstacle(0), b.obstacle(1)), expected);
+    }
+    // A fresh world (ship at the start, out of range) restored from after the
+    // activation keeps the activation times and the targets' positions.
+    let after = state_bytes(&a);
+    let mut c = world_with(&text, WorldConfig::default());
+    assert_eq!(c.activation_time(0), None);
+    c.read_state(&after).unwrap();
+    assert_eq!(
+        (c.activation_time(0), c.activation_time(1)),
+        (Some(t0), Some(t1))
+    );
+    assert_eq!(
+        (c.obstacle(0), c.obstacle(1)),
+        (a.obstacle(0), a.obstacle(1))
+    );
+    assert_eq!(state_bytes(&c), after);
+    // ... and reading the earlier state back clears them.
+    c.read_state(&before).unwrap();
+    assert_eq!(
+        (c.activation_time(0), c.obstacle(0).kind),
+        (None, KIND_NONE)
+    );
+}
+
+#[test]
+fn read_state_refuses_bad_activation_times() {
+    // Slot 0 a static hazard, slot 1 a range target activated at t_a.
+    let mut text = with_targets(&[(2.0, 3.0, "activation_range = 3.2")]);
+    text = text.replacen(
+        "\n[[obstacles]]",
+        "\n[[obstacles]]\nname = \"rock\"\nkind = \"static\"\nx = 9.0\ny = 9.0\ndiameter = 1.0\n\n[[obstacles]]",
+        1,
+    );
+    let mut a = world_with(&text, WorldConfig::default());
+    while a.activation_time(1).is_none() {
+        a.step(&PULL, 0.1).unwrap();
+    }
+    a.step(&PULL, 0.1).unwrap();
+    let saved = state_bytes(&a);
+    let slot_at = |slot: usize| STATE_BYTES - 8 * (MAX_OBSTACLES - slot);
+    assert_eq!(
+        saved[slot_at(1)..slot_at(1) + 8],
+        a.activation_time(1).unwrap().to_le_bytes()
+    );
+    let mut w = world_with(&text, WorldConfig::default());
+    let fresh = state_bytes(&w);
+    for (slot, value, reason) in [
+        (1, f64::INFINITY, "neither NaN"),
+        (1, -1.0, "neither NaN"),
+        (1, a.time() + 1.0, "neither NaN"),
+        (0, 1.0, "not a target ship"),
+        (5, 1.0, "not a target ship"),
+    ] {
+        let mut bad = saved.clone();
+        bad[slot_at(slot)..slot_at(slot) + 8].copy_from_slice(&value.to_le_bytes());
+        let e = w.read_state(&bad).unwrap_err();
+        assert!(
+            e.contains(&format!("activated_at[{slot}]")) && e.contains(reason),
+            "{e}"
+        );
+        assert_eq!(state_bytes(&w), fresh, "a refused state changed the world");
+    }
+    w.read_state(&saved).unwrap();
+    assert_eq!(w.activation_time(1), a.activation_time(1));
+}
+
+#[test]
+fn fingerprint_covers_the_activation_range() {
+    let a = world_with(
+        &with_targets(&[(2.0, 3.0, "activation_range = 3.2")]),
+        WorldConfig::default(),
+    );
+    let saved = state_bytes(&a);
+    for lines in [
+        "activation_range = 3.3",
+        "activation_range = 3.2\nactivation_time = 100.0",
+        "activation_time = 100.0",
+    ] {
+        let mut b = world_with(&with_targets(&[(2.0, 3.0, lines)]), WorldConfig::default());
+        assert!(
+            b.read_state(&saved)
+                .unwrap_err()
+                .contains("different scenario or configuration"),
+            "{lines}"
+        );
+    }
+    let mut same = world_with(
+        &with_targets(&[(2.0, 3.0, "activation_range = 3.2")]),
+        WorldConfig::default(),
+    );
+    same.read_state(&saved).unwrap();
+}
+
+#[test]
+fn paper_targets_b_and_c_wait_for_the_tow() {
+    // With the tow at rest at the route origin, B and C never appear, whatever
+    // the time (they appeared at 405 s and 590 s before range activation).
+    let s = Scenario::paper().unwrap();
+    let mut w = World::new(&s, WorldConfig::default()).unwrap();
+    w.step(&WorldInputs::default(), 700.0).unwrap();
+    assert_eq!(w.obstacle(3).kind, KIND_VESSEL);
+    assert_eq!(
+        (w.obstacle(4).kind, w.obstacle(5).kind),
+        (KIND_NONE, KIND_NONE)
+    );
+    // Put the ship where the paper's tow was at 405 s (kinematic estimate, see
+    // scenarios/paper.toml): B appears at the next step end, C does not.
+    let mut s = Scenario::paper().unwrap();
+    s.ship.eta[..2].copy_from_slice(&[-10.11, 33.03]);
+    s.place_tugs();
+    let mut w = World::new(&s, WorldConfig::default()).unwrap();
+    assert_eq!(w.activation_time(4), Some(0.0));
+    assert_eq!(w.activation_time(5), None);
+    // Just outside B's range: not yet.
+    let mut s = Scenario::paper().unwrap();
+    s.ship.eta[..2].copy_from_slice(&[-10.0, 33.0]);
+    s.place_tugs();
+    w = World::new(&s, WorldConfig::default()).unwrap();
+    assert!((w.ship().eta[0] + 22.0).hypot(w.ship().eta[1] - 40.75) > 14.2);
+    assert_eq!(w.activation_time(4), None);
+    // Where the paper's tow was at 590 s: C's range.
+    let mut s = Scenario::paper().unwrap();
+    s.ship.eta = [-18.22, 40.0, std::f64::consts::PI];
+    s.place_tugs();
+    let w = World::new(&s, WorldConfig::default()).unwrap();
+    assert_eq!(w.activation_time(5), Some(0.0));
+}
