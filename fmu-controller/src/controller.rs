@@ -416,6 +416,12 @@ impl Fmi2Model for ControllerFmu {
             last_sample_ns: 0,
         };
         self.outputs = Outputs::default();
+        // Until the first sample the outputs hold the command the controller starts
+        // from (the lines at their pretension, no thrust), so the first sample's rate
+        // bound is measured from what the plant was given.
+        let start = controller.applied();
+        self.outputs.command.tension = [start.ship[0], start.ship[1]];
+        self.outputs.command.tug_thrust = start.tugs;
         self.controller = Some(controller);
         log.info(
             "logEvents",

@@ -23,7 +23,9 @@ use fmi2_slave::description::{ModelDescription, Variable, VariableKind};
 use std::sync::LazyLock;
 use towing_control::{ControllerConfig, InnerLoopParams, TrackingParams};
 use towing_guidance::GuidanceSettings;
-use towing_interface::variables::{self as shared, exact_output, parameter, Direction};
+use towing_interface::variables::{
+    self as shared, calculated_output, exact_output, parameter, Direction,
+};
 use towing_interface::{ModelInfo, RealType, VESSELS};
 use towing_model::MAX_OBSTACLES;
 use towing_mpc::{AdmmSettings, PredictionParams, ShipMpcParams, TugMpcParams, HORIZON};
@@ -615,6 +617,31 @@ fn build() -> ModelDescription {
     }
     v.extend(shared::obstacles(Direction::Input));
     v.extend(shared::commands(Direction::Output));
+    // The tension commands start at the pretension `min_tension` (the command the
+    // controller starts from), so their initial value is calculated from it.
+    let min_tension_vr = REAL_PARAMETERS
+        .iter()
+        .position(|p| p.name == "min_tension")
+        .map(real_parameter_vr);
+    for var in v
+        .iter_mut()
+        .filter(|var| var.name.ends_with(".tension_cmd"))
+    {
+        let mut kind = var.kind.clone();
+        if let VariableKind::Real { start, .. } = &mut kind {
+            *start = None;
+        }
+        *var = calculated_output(
+            var.name.clone(),
+            var.value_reference,
+            kind,
+            format!(
+                "{}; starts at min_tension (the pretension) until the first sample",
+                var.description
+            ),
+            min_tension_vr.into_iter().collect(),
+        );
+    }
 
     // Diagnostics.
     v.push(exact_output(

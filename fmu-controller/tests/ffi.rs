@@ -11,6 +11,7 @@ use fmi2_slave::{Causality, ValueType, VariableKind};
 use support::*;
 use towing_controller::variables::{self as vars, DESCRIPTION, NO_OBSTACLE_DISTANCE};
 use towing_interface::testing;
+use towing_mpc::ShipMpcParams;
 
 fn var(name: &str) -> u32 {
     DESCRIPTION
@@ -81,6 +82,11 @@ fn outputs_hold_their_start_values_until_the_first_step() {
     {
         let vr = v.value_reference;
         match &v.kind {
+            VariableKind::Real { start: None, .. } => {
+                // The tension commands: calculated, the pretension.
+                assert!(v.name.ends_with(".tension_cmd"), "{}", v.name);
+                assert_eq!(fmu.get_real(vr), ShipMpcParams::default().min_tension);
+            }
             VariableKind::Real { start, .. } => {
                 assert_eq!(fmu.get_real(vr), start.unwrap(), "{}", v.name);
             }

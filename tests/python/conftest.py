@@ -33,3 +33,11 @@ def plant_fmu(fmus):
 @pytest.fixture(scope="session")
 def paper_scenario():
     return ROOT / "scenarios" / "paper.toml"
+
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers",
+        "closed_loop_long: 1200 s closed-loop acceptance runs of the paper scenario (minutes each); "
+        'deselect with -m "not closed_loop_long"',
+    )

@@ -32,12 +32,20 @@ pub struct FmuCrate {
 }
 
 /// The FMUs `cargo xtask fmu` packages.
-pub const FMUS: &[FmuCrate] = &[FmuCrate {
-    package: "fmu-plant",
-    lib_name: "towing_plant",
-    model_identifier: "TowingPlant",
-    resources: &[("scenarios/paper.toml", "paper.toml")],
-}];
+pub const FMUS: &[FmuCrate] = &[
+    FmuCrate {
+        package: "fmu-plant",
+        lib_name: "towing_plant",
+        model_identifier: "TowingPlant",
+        resources: &[("scenarios/paper.toml", "paper.toml")],
+    },
+    FmuCrate {
+        package: "fmu-controller",
+        lib_name: "towing_controller",
+        model_identifier: "TowingController",
+        resources: &[("scenarios/paper.toml", "paper.toml")],
+    },
+];
 
 /// Error of one xtask step: which step failed and why.
 #[derive(Debug)]
@@ -141,7 +149,8 @@ commands:
   model-description   regenerate modelDescription/<Model>.xml from the Rust variable tables
   python              create or refresh the Python environment (.venv) with fmpy and libcosimpy
   test                run every check CI runs (fmt, clippy, FMU packaging, Rust and Python tests)
-  demo                package the plant and run it under fmpy (writes out/plant-demo/)";
+  demo                package both FMUs and run the closed loop on the paper scenario under fmpy
+                      (writes out/paper/map.png, timeseries.csv, summary.json)";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -201,32 +210,44 @@ fn test_all() -> Result<()> {
     Ok(())
 }
 
-/// The README's main command (for now: the plant alone under fmpy with a constant input).
+/// The README's main command: both FMUs in closed loop under fmpy on the paper scenario
+/// for 1200 s (`masters/closed_loop.py`), writing `out/paper/` (map, time series, summary).
+/// The plant alone under constant inputs stays available as `masters/plant_demo.py`.
 fn demo() -> Result<()> {
+    const STEP: &str = "demo";
     let python = python::ensure_env()?;
     let fmus = fmu::package_all()?;
-    let plant = fmus
-        .iter()
-        .find(|p| p.ends_with("TowingPlant.fmu"))
-        .cloned()
-        .ok_or_else(|| StepError {
-            step: "demo".into(),
-            reason: "TowingPlant.fmu was not packaged".into(),
-        })?;
-    let out = root().join("out/plant-demo");
+    let find = |model: &str| {
+        fmus.iter()
+            .find(|p| {
+                p.file_name()
+                    .is_some_and(|n| n == format!("{model}.fmu").as_str())
+            })
+            .cloned()
+            .ok_or_else(|| StepError {
+                step: STEP.into(),
+                reason: format!("{model}.fmu was not packaged"),
+            })
+    };
+    let plant = find("TowingPlant")?;
+    let controller = find("TowingController")?;
+    let out = root().join("out/paper");
     run(
-        "plant demo under fmpy",
+        "closed loop under fmpy (paper scenario, 1200 s)",
         Command::new(&python)
-            .arg("masters/plant_demo.py")
-            .arg("--fmu")
+            .arg("masters/closed_loop.py")
+            .arg("--plant")
             .arg(&plant)
+            .arg("--controller")
+            .arg(&controller)
             .arg("--out")
             .arg(&out),
     )?;
     progress(&format!(
-        "demo finished: {} and {}",
-        out.join("track.csv").display(),
-        out.join("track.png").display()
+        "demo finished: map {}, time series {}, summary {}",
+        out.join("map.png").display(),
+        out.join("timeseries.csv").display(),
+        out.join("summary.json").display()
     ));
     Ok(())
 }

@@ -195,6 +195,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(v) = env("CENT_TOL") {
         config.centralized.tolerance = v;
     }
+    if let Some(v) = env("GW_LA") {
+        config.tracking.give_way_lookahead = v;
+    }
+    if let Some(v) = env("TUG_NMAX") {
+        config.tug.thrust_limit[2] = v;
+    }
+    if let Some(v) = env("TUG_TR_N") {
+        config.tug.trust_scale[2] = v;
+    }
+    if let Some(v) = env("CENT_IT") {
+        config.centralized.max_iterations = v as usize;
+    }
     if let (Some(w), Some(t)) = (env("TERM_W"), env("TERM_T")) {
         config.ship.terminal = Some(towing_mpc::TerminalCost {
             weight: w,
@@ -216,6 +228,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dest = scenario.route.destination;
     let mut settled_since: Option<f64> = None;
     let mut collisions = 0usize;
+    // Per obstacle slot: (CPA distance, time, relative bearing in deg) of target ships.
+    let mut cpa: [(f64, f64, f64); towing_model::MAX_OBSTACLES] =
+        [(f64::INFINITY, 0.0, 0.0); towing_model::MAX_OBSTACLES];
     let wall = std::time::Instant::now();
     for n in 0..steps {
         let m = measure(&world);
@@ -306,6 +321,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 settled_since = Some(world.time());
             }
         }
+        for (k, c) in cpa.iter_mut().enumerate() {
+            let o = world.obstacle(k);
+            if o.kind != 2 {
+                continue;
+            }
+            let s = world.ship().eta;
+            let (dx, dy) = (o.x - s[0], o.y - s[1]);
+            let d = dx.hypot(dy);
+            if d < c.0 {
+                *c = (
+                    d,
+                    world.time(),
+                    towing_model::wrap_angle(dy.atan2(dx) - s[2]).to_degrees(),
+                );
+            }
+        }
         if n % 5 == 0 {
             for o in overlaps(&world, &scenario) {
                 collisions += 1;
@@ -326,6 +357,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     }
+    let sides: Vec<String> = cpa
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.0.is_finite())
+        .map(|(k, c)| {
+            format!(
+                "obstacle[{}] CPA {:.2} m at {:.0} s bearing {:.0} ({})",
+                k + 1,
+                c.0,
+                c.1,
+                c.2,
+                if c.2 < 0.0 { "port" } else { "STARBOARD" }
+            )
+        })
+        .collect();
+    println!("{}", sides.join("; "));
     times.sort_by(f64::total_cmp);
     iters.sort_unstable();
     let s = world.ship();

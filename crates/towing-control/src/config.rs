@@ -131,6 +131,10 @@ pub struct TrackingParams {
     /// ([`Controller`](crate::Controller) docs); 0 tracks the reference
     /// system's waypoint `eta_Sd` itself, as the paper does.
     pub lookahead: f64,
+    /// Lookahead (m) while the route is altered for a crossing in which the tow
+    /// gives way: a nearer tracked point slackens the tow's speed (COLREGS Rule
+    /// 8(e), Rule 16) so the target crosses ahead and the tow passes astern.
+    pub give_way_lookahead: f64,
     /// Line-of-sight distance (m): while the ship is farther than this from the
     /// tracked point, the reference heading is the bearing from the ship to it
     /// (line of sight, Fossen 2011, section 10.3.2) instead of the waypoint's
@@ -146,6 +150,7 @@ impl Default for TrackingParams {
     fn default() -> Self {
         TrackingParams {
             lookahead: 3.5,
+            give_way_lookahead: 1.0,
             los_distance: 2.5,
         }
     }
@@ -246,6 +251,7 @@ impl ControllerConfig {
         }
         for (name, v) in [
             ("lookahead", self.tracking.lookahead),
+            ("give_way_lookahead", self.tracking.give_way_lookahead),
             ("los_distance", self.tracking.los_distance),
         ] {
             if !(v.is_finite() && v >= 0.0) {

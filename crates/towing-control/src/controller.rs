@@ -26,7 +26,7 @@ use std::time::Instant;
 
 use towing_guidance::{
     body_to_ned, role, GuidanceOutput, GuidanceParams, ObstacleInput, Pose, ReferenceSystem, Role,
-    TowState,
+    Situation, TowState,
 };
 use towing_model::{VesselData, MAX_OBSTACLES};
 use towing_mpc::{
@@ -307,7 +307,25 @@ impl Controller {
         } else {
             guidance.route_waypoint
         };
-        let reference = self.reference(&m.ship, guidance.active_waypoint, target);
+        let altered = guidance.altered && self.config.scheme.alters();
+        // Rule 8(e) and 16: give way in a crossing also by slackening speed (the
+        // tracked point comes nearer), so the target can pass ahead.
+        let giving_way = altered
+            && guidance
+                .governing
+                .is_some_and(|g| g.situation == Some(Situation::CrossingGiveWay));
+        let lookahead = if giving_way {
+            self.config.tracking.give_way_lookahead
+        } else {
+            self.config.tracking.lookahead
+        };
+        let reference = self.reference(
+            &m.ship,
+            guidance.active_waypoint,
+            target,
+            altered,
+            lookahead,
+        );
         let mut situation = [-1; MAX_OBSTACLES];
         let mut roles = [0; MAX_OBSTACLES];
         let status = self.config.guidance.colregs.tow_status;
@@ -438,15 +456,22 @@ impl Controller {
     /// `lookahead = 0` the reference system's waypoint `eta_Sd` (eq. (8)-(11));
     /// otherwise the point `lookahead` metres ahead of the ship's projection on
     /// the active leg (previous waypoint to `target`, the altered one while
-    /// altered), continued onto the next leg past `target`, and the destination
-    /// on the last leg (lookahead-based line of sight, Fossen 2011, section
+    /// altered), continued onto the next leg past `target` (not while altered:
+    /// the next leg is the unaltered route, which leads back towards the
+    /// target), and the destination on the last leg (lookahead-based line of sight, Fossen 2011, section
     /// 10.3.2). The heading is the bearing from the ship to that point while it
     /// is farther than `los_distance`, else the point's route heading.
-    fn reference(&self, ship: &[f64; 6], active: usize, target: Pose) -> [f64; 3] {
+    fn reference(
+        &self,
+        ship: &[f64; 6],
+        active: usize,
+        target: Pose,
+        altered: bool,
+        lookahead: f64,
+    ) -> [f64; 3] {
         let points = self.guidance.route().points();
         let last = points.len() - 1;
         let mut goal = target.eta();
-        let lookahead = self.config.tracking.lookahead;
         if lookahead > 0.0 {
             let prev = points[active - 1];
             let seg = [target.x - prev.x, target.y - prev.y];
@@ -458,7 +483,7 @@ impl Controller {
                 if remaining >= lookahead {
                     let s = along + lookahead;
                     goal = [prev.x + s * e[0], prev.y + s * e[1], target.psi];
-                } else if active < last {
+                } else if active < last && !altered {
                     let next = points[active + 1];
                     let seg2 = [next.x - target.x, next.y - target.y];
                     let len2 = seg2[0].hypot(seg2[1]);

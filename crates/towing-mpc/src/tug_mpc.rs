@@ -80,7 +80,7 @@ impl Default for TugMpcParams {
         TugMpcParams {
             weights: [1.0, 6.0, 1.0],
             thrust_limit: [10.0; 3],
-            trust_scale: [10.0; 3],
+            trust_scale: [10.0, 10.0, 1.0],
             scp: ScpSettings::default(),
             distance: DistanceCost::default(),
             clearance: ClearanceParams::with_min_distance(0.6),
