@@ -198,7 +198,7 @@ pub fn real_parameter_index(vr: u32) -> Option<usize> {
 }
 
 /// The Real parameters, in value-reference order (`10 + index`).
-pub const REAL_PARAMETERS: [RealParameter; 33] = [
+pub const REAL_PARAMETERS: [RealParameter; 34] = [
     RealParameter {
         name: "sample_time",
         unit: "s",
@@ -499,6 +499,15 @@ pub const REAL_PARAMETERS: [RealParameter; 33] = [
         description: "Beyond this distance from the tracked point the reference heading is the line-of-sight bearing to it, within it the route heading (Table 4); 2.5 m, two ship lengths; 0 always uses the route heading (docs/assumptions.md)",
         get: |t| t.tracking.los_distance,
         set: |t, v| t.tracking.los_distance = v,
+    },
+    RealParameter {
+        name: "give_way_lookahead",
+        unit: "m",
+        min: 0.0,
+        exclusive: false,
+        description: "Lookahead while the route is altered for a crossing in which the tow gives way: the nearer tracked point slackens the tow's speed so the target crosses ahead (COLREGS Rule 8(e), 16); 0 m: the point is the ship's own projection on the leg, the tow takes the way off (docs/assumptions.md)",
+        get: |t| t.tracking.give_way_lookahead,
+        set: |t, v| t.tracking.give_way_lookahead = v,
     },
 ];
 

@@ -89,6 +89,7 @@ fn parameter_start_values_are_the_rust_defaults() {
         ),
         ("lookahead", c.tracking.lookahead),
         ("los_distance", c.tracking.los_distance),
+        ("give_way_lookahead", c.tracking.give_way_lookahead),
     ];
     for (name, value) in &expected {
         assert_eq!(start_real(name), *value, "start value of {name}");

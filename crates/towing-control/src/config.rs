@@ -145,12 +145,13 @@ pub struct TrackingParams {
 }
 
 impl Default for TrackingParams {
-    /// `lookahead = 3.5 m`, `los_distance = 2.5 m` (two CyberShip II lengths);
+    /// `lookahead = 3.5 m`, `give_way_lookahead = 0 m`, `los_distance = 2.5 m`
+    /// (two CyberShip II lengths);
     /// why in `docs/assumptions.md`.
     fn default() -> Self {
         TrackingParams {
             lookahead: 3.5,
-            give_way_lookahead: 1.0,
+            give_way_lookahead: 0.0,
             los_distance: 2.5,
         }
     }

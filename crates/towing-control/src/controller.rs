@@ -472,7 +472,7 @@ impl Controller {
         let points = self.guidance.route().points();
         let last = points.len() - 1;
         let mut goal = target.eta();
-        if lookahead > 0.0 {
+        if self.config.tracking.lookahead > 0.0 {
             let prev = points[active - 1];
             let seg = [target.x - prev.x, target.y - prev.y];
             let len = seg[0].hypot(seg[1]);
