@@ -341,3 +341,27 @@ fn fmu_state_functions_are_refused_as_declared() {
     let fmu = initialized("serialize");
     refused(&fmu, fmu.deserialize(&[0u8; 16]));
 }
+
+/// A sample whose QPs fail (a circle of 100 m radius over the tow makes every
+/// clearance row infeasible) returns fmi2Warning with a "fallback:" log line, counts
+/// the fallback, and keeps the commands finite and within their bounds.
+#[test]
+fn a_failed_solve_is_a_warning_with_a_counted_fallback() {
+    let states = paper_states();
+    let ship = states[0];
+    let fmu = initialized("fallback");
+    let mut t = steps(&fmu, 0.0, 1.0, 2);
+    set_obstacle(&fmu, 7, [ship[0], ship[1], 0.0, 0.0, 200.0, 200.0], 1);
+    for k in 1..=3 {
+        assert_eq!(fmu.step(t, 1.0), Fmi2Status::Warning, "{}", fmu.log_text());
+        t += 1.0;
+        assert!(fmu.last_text().contains("fallback:"), "{}", fmu.log_text());
+        assert_eq!(fmu.get_integer(vars::FALLBACKS), k);
+        let c = commands(&fmu);
+        assert!(c.iter().all(|v| v.is_finite()), "{c:?}");
+        assert!(
+            c[6] >= 0.0 && c[6] <= 3.0 && c[7] >= 0.0 && c[7] <= 3.0,
+            "{c:?}"
+        );
+    }
+}

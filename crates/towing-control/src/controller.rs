@@ -177,7 +177,9 @@ pub struct Controller {
     /// The previous sample's plans, shifted: the fallback.
     spare_ship: [ShipInput; HORIZON],
     spare_tugs: [[TugInput; HORIZON]; 2],
-    have_spare: bool,
+    /// Genuine samples left in the spare plan (`H - 1` after a solved sample,
+    /// one less after each fallback; 0: the plan is used up).
+    spare_left: usize,
     /// Tug velocities at the start of the sample and predicted at its end.
     nu_start: [[f64; 3]; 2],
     nu_end: [[f64; 3]; 2],
@@ -258,7 +260,7 @@ impl Controller {
             },
             spare_ship: [[0.0; 4]; HORIZON],
             spare_tugs: [[[0.0; 3]; HORIZON]; 2],
-            have_spare: false,
+            spare_left: 0,
             nu_start: [[0.0; 3]; 2],
             nu_end: [[0.0; 3]; 2],
             fallbacks: 0,
@@ -373,7 +375,7 @@ impl Controller {
             self.spare_ship = std::array::from_fn(|h| ship_plan[shift(h)]);
             self.spare_tugs =
                 std::array::from_fn(|i| std::array::from_fn(|h| tug_plans[i][shift(h)]));
-            self.have_spare = true;
+            self.spare_left = HORIZON - 1;
             self.solver.shift();
         } else {
             let shift = |h: usize| (h + 1).min(HORIZON - 1);
@@ -513,15 +515,18 @@ impl Controller {
     }
 
     /// The spare plan's first sample, within the bounds and rate bounds of the
-    /// applied command (zero tension and thrust without a spare plan: the
-    /// safest command, the tow drifts to rest).
-    fn fallback_command(&self) -> (ShipInput, [TugInput; 2]) {
+    /// applied command. Once the spare plan is used up (or without one), the
+    /// command goes to rest: the tensions to the pretension and the angles to
+    /// zero at their rate bounds, no thrust; the tow then drifts to a stop.
+    fn fallback_command(&mut self) -> (ShipInput, [TugInput; 2]) {
         let p = &self.config.ship;
         let prev = self.applied.ship;
-        let wanted = if self.have_spare {
+        let have_spare = self.spare_left > 0;
+        self.spare_left = self.spare_left.saturating_sub(1);
+        let wanted = if have_spare {
             self.spare_ship[0]
         } else {
-            [0.0; 4]
+            [p.min_tension, p.min_tension, 0.0, 0.0]
         };
         let mut ship = [0.0; 4];
         for i in 0..2 {
@@ -533,7 +538,7 @@ impl Controller {
             ship[2 + i] = finite_or(wanted[2 + i], prev[2 + i]).clamp(lo.min(hi), hi);
         }
         let tugs = std::array::from_fn(|i| {
-            let w = if self.have_spare {
+            let w = if have_spare {
                 self.spare_tugs[i][0]
             } else {
                 [0.0; 3]

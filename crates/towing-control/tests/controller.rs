@@ -223,3 +223,66 @@ fn bad_configuration_values_are_named() {
     let err = Controller::new(config).unwrap_err();
     assert_eq!(err.name, "inner_loop_gain_sway");
 }
+
+#[test]
+fn a_failed_solve_applies_the_shifted_plan_within_bounds_then_comes_to_rest() {
+    let (scenario, m) = paper_measurement();
+    let config = ControllerConfig::new(scenario);
+    let p = config.ship;
+    let mut c = Controller::new(config.clone()).unwrap();
+    for _ in 0..4 {
+        let r = c.sample(&m).unwrap();
+        assert!(r.fallback.is_none(), "{:?}", r.fallback);
+    }
+    // A circle of 100 m radius on the ship: every clearance row would need more
+    // than the slack bound (10 m), so the QPs are infeasible.
+    let mut swallowed = m;
+    swallowed.obstacles[7] = ObstacleInput {
+        x: m.ship[0],
+        y: m.ship[1],
+        psi: 0.0,
+        speed: 0.0,
+        length: 200.0,
+        width: 200.0,
+        kind: 1,
+    };
+    let mut prev = c.applied().ship;
+    for k in 1..=6u64 {
+        let r = c.sample(&swallowed).unwrap();
+        let why = r.fallback.expect("an infeasible QP falls back");
+        assert!(
+            why.to_string().contains("QP gave no usable solution"),
+            "{why}"
+        );
+        assert_eq!(r.fallbacks, k);
+        assert_eq!(c.fallbacks(), k);
+        assert_within_bounds(&r.command, &config);
+        let now = [
+            r.command.tension[0],
+            r.command.tension[1],
+            r.desired_angle[0],
+            r.desired_angle[1],
+        ];
+        for i in 0..2 {
+            assert!((now[i] - prev[i]).abs() <= p.tension_rate + 1e-12);
+            assert!((now[2 + i] - prev[2 + i]).abs() <= p.angle_rate + 1e-12);
+        }
+        if k > 2 {
+            // The spare plan (H - 1 = 2 samples) is used up: towards rest.
+            assert_eq!(r.command.tug_thrust, [[0.0; 3]; 2]);
+            for i in 0..2 {
+                assert!(now[i] <= prev[i] + 1e-12, "tension does not grow at rest");
+            }
+        }
+        prev = now;
+    }
+    // At rest after enough samples: the pretension, straight lines.
+    for _ in 0..20 {
+        c.sample(&swallowed).unwrap();
+    }
+    let rest = c.applied().ship;
+    assert_eq!(rest, [p.min_tension, p.min_tension, 0.0, 0.0]);
+    // The obstacle gone, the next sample solves again (cold).
+    let r = c.sample(&m).unwrap();
+    assert!(r.fallback.is_none(), "{:?}", r.fallback);
+}
