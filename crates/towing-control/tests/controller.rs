@@ -33,6 +33,19 @@ fn paper_measurement() -> (Scenario, Measurement) {
     (scenario, m)
 }
 
+/// A static circle of `diameter` centred on the ship.
+fn circle_on_ship(m: &Measurement, diameter: f64) -> ObstacleInput {
+    ObstacleInput {
+        x: m.ship[0],
+        y: m.ship[1],
+        psi: 0.0,
+        speed: 0.0,
+        length: diameter,
+        width: diameter,
+        kind: 1,
+    }
+}
+
 fn assert_within_bounds(c: &towing_control::Command, config: &ControllerConfig) {
     for f in c.tension {
         assert!(
@@ -93,15 +106,7 @@ fn obstacles_on_top_of_the_tow_give_a_bounded_command_without_fallback_panics() 
     let config = ControllerConfig::new(scenario);
     let mut c = Controller::new(config.clone()).unwrap();
     // A static circle on the ship, a target ship on tug 2, another on tug 1.
-    m.obstacles[0] = ObstacleInput {
-        x: m.ship[0],
-        y: m.ship[1],
-        psi: 0.0,
-        speed: 0.0,
-        length: 1.0,
-        width: 1.0,
-        kind: 1,
-    };
+    m.obstacles[0] = circle_on_ship(&m, 1.0);
     m.obstacles[1] = ObstacleInput {
         x: m.tugs[1][0],
         y: m.tugs[1][1],
@@ -237,15 +242,7 @@ fn a_failed_solve_applies_the_shifted_plan_within_bounds_then_comes_to_rest() {
     // A circle of 100 m radius on the ship: every clearance row would need more
     // than the slack bound (10 m), so the QPs are infeasible.
     let mut swallowed = m;
-    swallowed.obstacles[7] = ObstacleInput {
-        x: m.ship[0],
-        y: m.ship[1],
-        psi: 0.0,
-        speed: 0.0,
-        length: 200.0,
-        width: 200.0,
-        kind: 1,
-    };
+    swallowed.obstacles[7] = circle_on_ship(&m, 200.0);
     let mut prev = c.applied().ship;
     for k in 1..=6u64 {
         let r = c.sample(&swallowed).unwrap();
