@@ -31,6 +31,13 @@ def plant_fmu(fmus):
 
 
 @pytest.fixture(scope="session")
+def controller_fmu(fmus):
+    if "TowingController" not in fmus:
+        pytest.fail(f"`cargo xtask fmu` did not package TowingController.fmu (packaged: {sorted(fmus)})")
+    return fmus["TowingController"]
+
+
+@pytest.fixture(scope="session")
 def paper_scenario():
     return ROOT / "scenarios" / "paper.toml"
 

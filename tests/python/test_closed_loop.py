@@ -350,13 +350,6 @@ def test_master_help_documents_the_options():
 # --------------------------------------------------------------------------- with the controller FMU
 
 
-@pytest.fixture(scope="session")
-def controller_fmu(fmus):
-    if "TowingController" not in fmus:
-        pytest.fail(f"`cargo xtask fmu` did not package TowingController.fmu (packaged: {sorted(fmus)})")
-    return fmus["TowingController"]
-
-
 def test_short_closed_loop_on_the_paper_scenario(plant_fmu, controller_fmu, tmp_path):
     r = run_master(tmp_path, "--plant", plant_fmu, "--controller", controller_fmu, "--stop-time", 60, "--map-size", "800x600")
     assert r.returncode == 0, r.stdout + r.stderr

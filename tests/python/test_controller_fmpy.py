@@ -1,0 +1,59 @@
+"""The packaged TowingController FMU under fmpy: validation, capabilities, refused inputs."""
+
+import fmpy
+import pytest
+from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi1 import FMICallException
+from fmpy.validation import validate_fmu
+from fmu_logging import MessageLog
+
+
+def test_validate_fmu_reports_no_problems(controller_fmu):
+    assert validate_fmu(controller_fmu) == []
+
+
+def test_model_description_capabilities(controller_fmu):
+    md = fmpy.read_model_description(controller_fmu)
+    cs = md.coSimulation
+    assert cs.modelIdentifier == "TowingController"
+    # The solvers' warm starts are not copied or serialised: declared and refused.
+    assert not cs.canGetAndSetFMUstate and not cs.canSerializeFMUstate
+    names = {v.name: v for v in md.modelVariables}
+    for p in ("architecture", "avoidance_scheme", "scenario", "sample_time", "rho", "max_iterations",
+              "detection_distance", "safety_buffer", "waterway_half_width", "w_S1", "w_S2", "w_S3",
+              "w_T1", "w_T2", "w_T3", "eps_abs", "eps_rel", "altering_angle"):
+        assert names[p].causality == "parameter", p
+    assert names["architecture"].start == "1" and names["avoidance_scheme"].start == "1"
+    assert float(names["sample_time"].start) == 1.0
+
+
+def instantiate(controller_fmu, tmp_path, name):
+    unzipdir = fmpy.extract(controller_fmu, str(tmp_path / name))
+    md = fmpy.read_model_description(controller_fmu)
+    log = MessageLog()
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier="TowingController", instanceName=name)
+    fmu.instantiate(callbacks=log.callbacks)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    return fmu, vr, log
+
+
+def test_nan_input_is_refused_naming_the_variable(controller_fmu, tmp_path):
+    fmu, vr, log = instantiate(controller_fmu, tmp_path, "nan")
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    with pytest.raises(FMICallException):
+        fmu.setReal([vr["tug2.v"]], [float("nan")])
+    assert "tug2.v" in log.text(), log.text()
+    fmu.freeInstance()
+
+
+def test_bad_architecture_is_refused_at_initialization(controller_fmu, tmp_path):
+    fmu, vr, log = instantiate(controller_fmu, tmp_path, "arch")
+    fmu.setupExperiment(startTime=0.0)
+    fmu.setInteger([vr["architecture"]], [3])
+    fmu.enterInitializationMode()
+    with pytest.raises(FMICallException):
+        fmu.exitInitializationMode()
+    assert "architecture" in log.text(), log.text()
+    fmu.freeInstance()
