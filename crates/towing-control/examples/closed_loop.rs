@@ -195,6 +195,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(v) = env("CENT_TOL") {
         config.centralized.tolerance = v;
     }
+    if let Some(v) = env("CENT_GOOD") {
+        config.centralized.scp.good = v;
+    }
+    if let Some(v) = env("CENT_POOR") {
+        config.centralized.scp.poor = v;
+    }
     if let Some(v) = env("GW_LA") {
         config.tracking.give_way_lookahead = v;
     }

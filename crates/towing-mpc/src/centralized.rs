@@ -974,7 +974,11 @@ impl Centralized {
             let usable = report.qp.is_usable();
             failed_steps += usize::from(!usable);
             last = Some(report);
-            let stationary = usable && !report.accepted && report.ratio == 1.0;
+            // Nothing left to gain by the model's own measure: a predicted decrease
+            // below 1e-6 of the cost (or an exactly stationary step).
+            let stationary = usable
+                && ((!report.accepted && report.ratio == 1.0)
+                    || report.predicted_decrease <= 1e-6 * report.cost_before.abs().max(1.0));
             if (report.accepted && change < self.problem.settings.tolerance) || stationary {
                 converged = true;
                 break;
