@@ -130,7 +130,7 @@ pub struct CentralizedSettings {
 impl Default for CentralizedSettings {
     fn default() -> Self {
         CentralizedSettings {
-            max_iterations: 40,
+            max_iterations: 60,
             tolerance: 1e-4,
             consensus_penalty: 1e3,
             max_consensus_slack: 10.0,
