@@ -44,6 +44,7 @@ struct Parameters {
     architecture: i32,
     avoidance_scheme: i32,
     max_iterations: i32,
+    prediction_horizon: i32,
     reals: [f64; REAL_PARAMETERS.len()],
 }
 
@@ -59,6 +60,7 @@ impl Default for Parameters {
             architecture: int(vars::ARCHITECTURE),
             avoidance_scheme: int(vars::AVOIDANCE_SCHEME),
             max_iterations: int(vars::MAX_ITERATIONS),
+            prediction_horizon: int(vars::PREDICTION_HORIZON),
             reals: std::array::from_fn(|i| (REAL_PARAMETERS[i].get)(&defaults)),
         }
     }
@@ -97,6 +99,13 @@ impl Parameters {
                     self.max_iterations
                 )
             })?;
+        if usize::try_from(self.prediction_horizon) != Ok(towing_mpc::HORIZON) {
+            return Err(format!(
+                "parameter `prediction_horizon`: this build is compiled for H_P = {} (Table 3), got {}",
+                towing_mpc::HORIZON,
+                self.prediction_horizon
+            ));
+        }
         for (p, &value) in REAL_PARAMETERS.iter().zip(&self.reals) {
             let ok = value.is_finite()
                 && if p.exclusive {
@@ -469,6 +478,7 @@ impl Fmi2Model for ControllerFmu {
             vars::ARCHITECTURE => self.params.architecture,
             vars::AVOIDANCE_SCHEME => self.params.avoidance_scheme,
             vars::MAX_ITERATIONS => self.params.max_iterations,
+            vars::PREDICTION_HORIZON => self.params.prediction_horizon,
             vars::ADMM_ITERATIONS => o.iterations,
             vars::FALLBACKS => o.fallbacks,
             vars::SAMPLES => o.samples,
@@ -491,6 +501,7 @@ impl Fmi2Model for ControllerFmu {
             vars::ARCHITECTURE => self.params.architecture = value,
             vars::AVOIDANCE_SCHEME => self.params.avoidance_scheme = value,
             vars::MAX_ITERATIONS => self.params.max_iterations = value,
+            vars::PREDICTION_HORIZON => self.params.prediction_horizon = value,
             1000..=1079 if (vr - 1000) % 10 == vars::OBSTACLE_KIND => {
                 self.inputs.measurement.obstacles[((vr - 1000) / 10) as usize].kind = value;
             }

@@ -12,7 +12,7 @@
 //!
 //! | range | what |
 //! |---|---|
-//! | 1..=9 | String and Integer parameters ([`SCENARIO`] .. [`MAX_ITERATIONS`]) |
+//! | 1..=9 | String and Integer parameters ([`SCENARIO`] .. [`PREDICTION_HORIZON`]) |
 //! | 10..=99 | Real parameters ([`REAL_PARAMETERS`], `10 + index`) |
 //! | 100..=1079 | the connected variables of `towing-interface` (vessel states, commands, towlines, obstacle slots) |
 //! | 3000..=3041 | diagnostics: ADMM, timing, reference, guidance, desired angles |
@@ -47,6 +47,8 @@ pub const ARCHITECTURE: u32 = 4;
 pub const AVOIDANCE_SCHEME: u32 = 5;
 /// `max_iterations` (Integer parameter): the ADMM's `S`.
 pub const MAX_ITERATIONS: u32 = 6;
+/// `prediction_horizon` (H_P of Table 3; compiled in as [`HORIZON`]).
+pub const PREDICTION_HORIZON: u32 = 7;
 
 /// `admm.iterations` (Integer output).
 pub const ADMM_ITERATIONS: u32 = 3000;
@@ -514,7 +516,7 @@ pub const REAL_PARAMETERS: [RealParameter; 34] = [
 /// Start values of the Integer parameters `hull_model`, `architecture`,
 /// `avoidance_scheme`, `max_iterations`, from the Rust defaults.
 #[must_use]
-pub fn integer_parameter_defaults() -> [(u32, i32); 4] {
+pub fn integer_parameter_defaults() -> [(u32, i32); 5] {
     let admm = AdmmSettings::default();
     [
         (HULL_MODEL, 0),
@@ -527,7 +529,13 @@ pub fn integer_parameter_defaults() -> [(u32, i32); 4] {
             MAX_ITERATIONS,
             i32::try_from(admm.max_iterations).unwrap_or(i32::MAX),
         ),
+        (PREDICTION_HORIZON, horizon()),
     ]
+}
+
+/// The compiled prediction horizon as an FMI Integer.
+fn horizon() -> i32 {
+    i32::try_from(HORIZON).unwrap_or(i32::MAX)
 }
 
 /// The controller's model description, built once.
@@ -609,6 +617,17 @@ fn build() -> ModelDescription {
                 max: Some(i32::try_from(towing_mpc::admm::MAX_ITERATIONS).unwrap_or(i32::MAX)),
             },
             "Most ADMM iterations S per sample (Algorithm 1); not given by the paper, 30 chosen by measurement (docs/assumptions.md). The last iterate is applied when eq. (29) is not met (admm.converged = false)",
+        ),
+        parameter(
+            "prediction_horizon",
+            PREDICTION_HORIZON,
+            VariableKind::Integer {
+                declared_type: None,
+                start: Some(horizon()),
+                min: Some(horizon()),
+                max: Some(horizon()),
+            },
+            "Prediction horizon H_P in samples (Table 3: 3). The QPs' structure is compiled for it (towing_mpc::HORIZON); any other value is refused at initialization",
         ),
     ];
     for (i, p) in REAL_PARAMETERS.iter().enumerate() {

@@ -134,7 +134,7 @@ type SetParameter = Box<dyn Fn(&fmi2_slave::testing::Fmu) -> Fmi2Status>;
 
 #[test]
 fn bad_parameters_are_refused_at_exit_initialization_naming_them() {
-    let cases: [(&str, SetParameter); 7] = [
+    let cases: [(&str, SetParameter); 8] = [
         (
             "architecture",
             Box::new(|f| f.set_integer(var("architecture"), 7)),
@@ -158,6 +158,10 @@ fn bad_parameters_are_refused_at_exit_initialization_naming_them() {
         (
             "max_iterations",
             Box::new(|f| f.set_integer(var("max_iterations"), 0)),
+        ),
+        (
+            "prediction_horizon",
+            Box::new(|f| f.set_integer(var("prediction_horizon"), 5)),
         ),
         ("rho", Box::new(|f| f.set_real(var("rho"), -0.5))),
     ];

@@ -110,13 +110,17 @@ fn parameter_start_values_are_the_rust_defaults() {
         start_integer("max_iterations"),
         i32::try_from(c.admm.max_iterations).unwrap()
     );
+    assert_eq!(
+        start_integer("prediction_horizon"),
+        i32::try_from(towing_mpc::HORIZON).unwrap()
+    );
     let n_params = DESCRIPTION
         .variables
         .iter()
         .filter(|v| v.causality == Causality::Parameter)
         .count();
-    // 2 String + 4 Integer + the Reals above and waterway_half_width.
-    assert_eq!(n_params, 2 + 4 + expected.len() + 1);
+    // 2 String + 5 Integer + the Reals above and waterway_half_width.
+    assert_eq!(n_params, 2 + 5 + expected.len() + 1);
 }
 
 /// Every name a master connects by must exist in both FMUs with the same type and unit.
