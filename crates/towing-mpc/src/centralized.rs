@@ -964,6 +964,11 @@ impl Centralized {
             }
         }
         let start = Start::of(input);
+        // A trust region shrunk by the previous sample's last steps would make
+        // this sample crawl from the start: at least the initial radius.
+        if self.trust.radius() < self.problem.settings.scp.initial_radius {
+            self.trust.reset();
+        }
         let mut iterations = 0;
         let mut failed_steps = 0;
         let mut converged = false;
