@@ -385,11 +385,32 @@ def test_a_discarded_step_stops_the_run_with_the_plants_message(plant_fmu, contr
     assert not (tmp_path / "out" / "timeseries.csv").exists()
 
 
-CASES = [(a, s) for a in (1, 2) for s in (1, 2, 3)]
+# Known, open failures (issue 3, recorded in its note), strict: the day one passes, its
+# marker must go.
+# - Centralized, scheme I: the tow gives way to target A by stopping (as the distributed
+#   one does) but, at rest, its heading drifts from 96 to 88 deg instead of turning to the
+#   altered 116 deg (the tugs' distance cost resists swinging tug 2 towards A); A then
+#   crosses 5.5 m ahead at a relative bearing of +2 deg, on the starboard side by the
+#   test's criterion.
+# - Centralized, scheme III: the ship reaches the destination and holds it from about
+#   1000 s, then a spontaneous manoeuvre at about 1126 s (both tensions to 0.26 N with
+#   the ship at rest) moves it off by 0.3-0.5 m and it has not settled again at 1200 s.
+KNOWN_FAILURES = {
+    (2, 1): "centralized scheme I: at rest for target A the heading drifts to port; A passes 2 deg to starboard (open, issue 3 note)",
+    (2, 3): "centralized scheme III leaves the destination again at about 1126 s (open, issue 3 note)",
+}
+CASES = [
+    pytest.param(a, s, marks=pytest.mark.xfail(strict=True, reason=KNOWN_FAILURES[(a, s)]))
+    if (a, s) in KNOWN_FAILURES
+    else (a, s)
+    for a in (1, 2)
+    for s in (1, 2, 3)
+]
+CASE_IDS = [f"{'distributed' if a == 1 else 'centralized'}-scheme{s}" for a in (1, 2) for s in (1, 2, 3)]
 
 
 @pytest.mark.closed_loop_long
-@pytest.mark.parametrize("architecture, scheme", CASES, ids=[f"{'distributed' if a == 1 else 'centralized'}-scheme{s}" for a, s in CASES])
+@pytest.mark.parametrize("architecture, scheme", CASES, ids=CASE_IDS)
 def test_paper_scenario_acceptance(plant_fmu, controller_fmu, paper_scenario, architecture, scheme, record_property):
     """1200 s of the paper scenario, judged by the paper's criteria. For scheme III (distance
     cost only) the side on which each target passes is recorded (record_property and the
