@@ -32,7 +32,8 @@ pub struct GuidanceSettings {
     /// by the range sensors" and larger than every safe distance of eq. (14). 7 m
     /// is where the paper's first avoidance starts: at 100 s the tow is near W_P1
     /// and its forward tug about 7 m from target A (the other two windows start
-    /// when targets B and C appear, 11 m and 14 m away, so they say nothing about
+    /// when targets B and C appear (by range, 14.2 m and 19.8 m from the ship,
+    /// `scenarios/paper.toml`), so they say nothing about
     /// `d_D`). It is three times the largest safe distance against
     /// the paper's targets (2.245 m, ship vs a 1.48 m target, range units), and at
     /// the paper's closing speeds (0.1 m/s tow, 0.07 m/s target) it leaves about

@@ -28,7 +28,9 @@ fn tow_at(ship: Pose, speed: f64) -> TowState {
 }
 
 /// Table 5 at time `t`: hazards a, b, c (slots 0-2), targets A, B, C (3-5)
-/// heading North at 0.07 m/s from their activation times 0, 405, 590 s.
+/// heading North at 0.07 m/s from activation times 0, 405, 590 s: this kinematic test
+/// fixes the times the paper's encounter windows give (the plant's scenario activates B
+/// and C by range instead, `scenarios/paper.toml`).
 fn traffic(t: f64) -> [ObstacleInput; 6] {
     let hazard = |x, y| ObstacleInput {
         x,
