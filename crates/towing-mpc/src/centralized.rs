@@ -903,8 +903,17 @@ impl Centralized {
         for c in &layout.clearance {
             predicted += c.predicted_decrease(du);
         }
+        // The penalty's decrease from the linear model itself, |r| - |r + J du|,
+        // not from the slacks: their solver tolerance (about 1e-6 each, times W_c)
+        // would swamp small steps and keep the trust ratio near 0.6.
         for m in 0..NC {
-            predicted += w_c * (self.cons.r[m].abs() - du[NU + m] / SLACK_SCALE);
+            let lin: f64 = self.cons.r[m]
+                + self.cons.rows[m]
+                    .iter()
+                    .zip(&du[..NU])
+                    .map(|(a, b)| a * b)
+                    .sum::<f64>();
+            predicted += w_c * (self.cons.r[m].abs() - lin.abs());
         }
         for h in 0..HORIZON {
             for k in 0..4 {
