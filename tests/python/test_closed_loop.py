@@ -393,11 +393,11 @@ def test_a_discarded_step_stops_the_run_with_the_plants_message(plant_fmu, contr
 #   crosses 5.5 m ahead at a relative bearing of +2 deg, on the starboard side by the
 #   test's criterion.
 # - Centralized, scheme III: the ship reaches the destination and holds it from about
-#   1000 s, then a spontaneous manoeuvre at about 1126 s (both tensions to 0.26 N with
-#   the ship at rest) moves it off by 0.3-0.5 m and it has not settled again at 1200 s.
+#   1000 s, then creeps forward from about 1120 s (both lines at the 0.1 N pretension),
+#   is pulled back, and has not settled again at 1200 s.
 KNOWN_FAILURES = {
     (2, 1): "centralized scheme I: at rest for target A the heading drifts to port; A passes 2 deg to starboard (open, issue 3 note)",
-    (2, 3): "centralized scheme III leaves the destination again at about 1126 s (open, issue 3 note)",
+    (2, 3): "centralized scheme III leaves the destination again at about 1120 s (open, issue 3 note)",
 }
 CASES = [
     pytest.param(a, s, marks=pytest.mark.xfail(strict=True, reason=KNOWN_FAILURES[(a, s)]))
