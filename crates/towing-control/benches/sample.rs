@@ -9,34 +9,10 @@ use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use towing_control::{Architecture, Controller, ControllerConfig, Measurement};
-use towing_guidance::ObstacleInput;
 use towing_model::{Scenario, World, WorldInputs};
 
 const STEP: f64 = 0.1;
 const WINDOW: (f64, f64) = (100.0, 200.0);
-
-fn measure(world: &World) -> Measurement {
-    let v =
-        |s: &towing_model::VesselState| [s.eta[0], s.eta[1], s.eta[2], s.nu[0], s.nu[1], s.nu[2]];
-    let mut m = Measurement {
-        ship: v(world.ship()),
-        tugs: [v(world.tug(0)), v(world.tug(1))],
-        ..Measurement::default()
-    };
-    for (k, slot) in m.obstacles.iter_mut().enumerate() {
-        let o = world.obstacle(k);
-        *slot = ObstacleInput {
-            x: o.x,
-            y: o.y,
-            psi: o.psi,
-            speed: o.speed,
-            length: o.length,
-            width: o.width,
-            kind: o.kind,
-        };
-    }
-    m
-}
 
 /// The closed loop, advanced one control sample at a time.
 struct Loop {
@@ -65,12 +41,12 @@ impl Loop {
 
     /// One sample and its ten communication steps; returns the sample's time.
     fn sample(&mut self) -> Duration {
-        let m = measure(&self.world);
+        let m = Measurement::from_world(&self.world);
         let start = Instant::now();
         self.controller.sample(&m).unwrap();
         let spent = start.elapsed();
         for n in 0..10 {
-            let m = measure(&self.world);
+            let m = Measurement::from_world(&self.world);
             let c = self.controller.command_at(n as f64 * STEP, &m).unwrap();
             self.world
                 .step(

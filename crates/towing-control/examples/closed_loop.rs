@@ -8,7 +8,6 @@
 use std::io::Write;
 
 use towing_control::{AvoidanceScheme, Controller, ControllerConfig, Measurement};
-use towing_guidance::ObstacleInput;
 use towing_model::{Scenario, World, WorldInputs};
 
 /// Hull outline (rectangle `length x width` at the pose) as boundary samples.
@@ -111,29 +110,6 @@ fn overlaps(world: &World, scenario: &Scenario) -> Vec<String> {
         }
     }
     out
-}
-
-fn measure(world: &World) -> Measurement {
-    let v =
-        |s: &towing_model::VesselState| [s.eta[0], s.eta[1], s.eta[2], s.nu[0], s.nu[1], s.nu[2]];
-    let mut m = Measurement {
-        ship: v(world.ship()),
-        tugs: [v(world.tug(0)), v(world.tug(1))],
-        ..Measurement::default()
-    };
-    for (k, slot) in m.obstacles.iter_mut().enumerate() {
-        let o = world.obstacle(k);
-        *slot = ObstacleInput {
-            x: o.x,
-            y: o.y,
-            psi: o.psi,
-            speed: o.speed,
-            length: o.length,
-            width: o.width,
-            kind: o.kind,
-        };
-    }
-    m
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -239,7 +215,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         [(f64::INFINITY, 0.0, 0.0); towing_model::MAX_OBSTACLES];
     let wall = std::time::Instant::now();
     for n in 0..steps {
-        let m = measure(&world);
+        let m = Measurement::from_world(&world);
         if n % per_sample == 0 {
             let r = controller.sample(&m)?;
             times.push(r.compute_time * 1e3);

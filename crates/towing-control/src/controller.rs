@@ -28,7 +28,7 @@ use towing_guidance::{
     body_to_ned, role, GuidanceOutput, GuidanceParams, ObstacleInput, Pose, ReferenceSystem, Role,
     Situation, TowState,
 };
-use towing_model::{VesselData, MAX_OBSTACLES};
+use towing_model::{VesselData, VesselState, World, MAX_OBSTACLES};
 use towing_mpc::{
     Admm, AppliedCommand, Centralized, Obstacle, QpOutcome, SampleInput, ShipInput, ShipModel,
     ShipState, TugInput, TugState, HORIZON,
@@ -75,6 +75,32 @@ impl Measurement {
             })?;
         }
         Ok(())
+    }
+
+    /// The plant's outputs, read straight from a [`World`] (the Rust-only
+    /// closed loop of the example, the bench and the tests; an FMU master copies
+    /// the same values by name).
+    #[must_use]
+    pub fn from_world(world: &World) -> Measurement {
+        let v = |s: &VesselState| [s.eta[0], s.eta[1], s.eta[2], s.nu[0], s.nu[1], s.nu[2]];
+        let mut m = Measurement {
+            ship: v(world.ship()),
+            tugs: [v(world.tug(0)), v(world.tug(1))],
+            ..Measurement::default()
+        };
+        for (k, slot) in m.obstacles.iter_mut().enumerate() {
+            let o = world.obstacle(k);
+            *slot = ObstacleInput {
+                x: o.x,
+                y: o.y,
+                psi: o.psi,
+                speed: o.speed,
+                length: o.length,
+                width: o.width,
+                kind: o.kind,
+            };
+        }
+        m
     }
 
     fn tow_state(&self) -> TowState {

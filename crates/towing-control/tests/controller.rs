@@ -11,26 +11,7 @@ use towing_model::{Scenario, World};
 fn paper_measurement() -> (Scenario, Measurement) {
     let scenario = Scenario::paper().unwrap();
     let world = World::new(&scenario, scenario.world_config).unwrap();
-    let v =
-        |s: &towing_model::VesselState| [s.eta[0], s.eta[1], s.eta[2], s.nu[0], s.nu[1], s.nu[2]];
-    let mut m = Measurement {
-        ship: v(world.ship()),
-        tugs: [v(world.tug(0)), v(world.tug(1))],
-        ..Measurement::default()
-    };
-    for (k, slot) in m.obstacles.iter_mut().enumerate() {
-        let o = world.obstacle(k);
-        *slot = ObstacleInput {
-            x: o.x,
-            y: o.y,
-            psi: o.psi,
-            speed: o.speed,
-            length: o.length,
-            width: o.width,
-            kind: o.kind,
-        };
-    }
-    (scenario, m)
+    (scenario, Measurement::from_world(&world))
 }
 
 /// A static circle of `diameter` centred on the ship.
