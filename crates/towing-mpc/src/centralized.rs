@@ -83,7 +83,7 @@ use crate::scp::{
 use crate::ship::{ShipInput, ShipLinearisation, ShipModel, ShipState};
 use crate::ship_mpc::{ship_stage_terms, ShipMpcParams};
 use crate::tug::{TowlinePull, TugInput, TugLinearisation, TugModel, TugState};
-use crate::tug_mpc::{rejected, TugMpcParams, HORIZON};
+use crate::tug_mpc::{TugMpcParams, HORIZON};
 
 /// Inputs per sample: 4 ship, 3 + 3 tugs.
 const PER_STEP: usize = 10;
@@ -313,26 +313,9 @@ fn sens_rows(s: &Sens) -> [[f64; NU]; 6] {
 }
 
 impl Problem {
-    /// `(lower, upper, rate)` of ship channel `k` (0, 1: tensions; 2, 3: angles).
-    fn ship_limits(&self, k: usize) -> (f64, f64, f64) {
-        let p = &self.ship_params;
-        if k < 2 {
-            (p.min_tension, p.max_tension, p.tension_rate)
-        } else {
-            (-p.max_angle, p.max_angle, p.angle_rate)
-        }
-    }
-
     /// Projects `plan` onto the bounds and rate bounds (as the subproblems do).
     fn project(&self, plan: &mut Plan, previous: &ShipInput) {
-        for k in 0..4 {
-            let (lo, hi, rate) = self.ship_limits(k);
-            let mut before = previous[k].clamp(lo, hi);
-            for u in &mut plan.ship {
-                u[k] = u[k].clamp(lo.max(before - rate), hi.min(before + rate));
-                before = u[k];
-            }
-        }
+        self.ship_params.project(&mut plan.ship, previous);
         let lim = self.tug_params.thrust_limit;
         for tau in plan.tugs.iter_mut().flatten() {
             for (t, l) in tau.iter_mut().zip(lim) {
@@ -807,7 +790,7 @@ impl Centralized {
         let radius = self.trust.radius();
         let (mut lo, mut hi) = ([0.0; NU], [0.0; NU]);
         for k in 0..4 {
-            let (l0, h0, rate) = p.ship_limits(k);
+            let (l0, h0, rate) = p.ship_params.channel_limits(k);
             let tr = radius * p.ship_params.trust_scale[k / 2];
             let prev = input.previous.ship[k].clamp(l0, h0);
             for h in 0..HORIZON {
@@ -853,7 +836,7 @@ impl Centralized {
             set_box(qp, j, lo[j], hi[j]);
         }
         for k in 0..4 {
-            let rate = p.ship_limits(k).2;
+            let rate = p.ship_params.channel_limits(k).2;
             for h in 1..HORIZON {
                 let diff = self.plan.ship[h][k] - self.plan.ship[h - 1][k];
                 let row = layout.rate_row + 2 * (4 * (h - 1) + k);
@@ -894,7 +877,7 @@ impl Centralized {
         if !outcome.is_usable() {
             self.trust.fail();
             return (
-                rejected(outcome, cost_before, self.trust.radius(), iterations),
+                ScpReport::rejected(outcome, cost_before, self.trust.radius(), iterations),
                 0.0,
             );
         }
@@ -1010,7 +993,7 @@ impl Centralized {
             input,
         );
         let last_step = last.unwrap_or_else(|| {
-            rejected(
+            ScpReport::rejected(
                 QpOutcome::Failed(crate::QpFailure::Other),
                 f64::NAN,
                 self.trust.radius(),

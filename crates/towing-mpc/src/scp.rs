@@ -83,6 +83,26 @@ pub struct ScpReport {
 }
 
 impl ScpReport {
+    /// The report of a step whose QP gave no usable solution (`outcome`): the
+    /// plan is kept.
+    pub(crate) fn rejected(
+        outcome: QpOutcome,
+        cost_before: f64,
+        radius: f64,
+        qp_iterations: u32,
+    ) -> ScpReport {
+        ScpReport {
+            qp: outcome,
+            accepted: false,
+            cost_before,
+            cost_after: cost_before,
+            predicted_decrease: 0.0,
+            ratio: f64::NAN,
+            radius,
+            qp_iterations,
+        }
+    }
+
     /// The report of a step whose QP gave `outcome`, with `costs = [before,
     /// candidate, predicted decrease]` and the trust region's verdict.
     pub(crate) fn judged(
@@ -576,6 +596,66 @@ pub(crate) fn condense<const M: usize, const H: usize>(
             }
         }
     }
+}
+
+/// Loads one SCP step's QP into the smallest of `variants` (one layout per
+/// number of clearance slots per sample, the last the full one, which holds the
+/// rows recorded at the linearisation) that still holds the clearance rows the
+/// boxes `[lo, hi]` leave binding: drops the others, copies the rest into that
+/// layout, then loads the quadratic model and the boxes. `parts` gives a
+/// variant's QP and clearance rows. Returns the layout's index.
+pub(crate) fn load_layout<V>(
+    variants: &mut [V],
+    parts: fn(&mut V) -> (&mut Qp, &mut Clearance),
+    quad: &QuadModel,
+    lo: &[f64],
+    hi: &[f64],
+) -> usize {
+    let full = variants.len() - 1;
+    let used = {
+        let (_, rows) = parts(&mut variants[full]);
+        rows.drop_redundant(lo, hi);
+        rows.slots_used()
+    };
+    if used < full {
+        let (small, large) = variants.split_at_mut(full);
+        let (_, rows) = parts(&mut large[0]);
+        parts(&mut small[used]).1.copy_from(rows);
+    }
+    let (qp, rows) = parts(&mut variants[used]);
+    load_model(qp, quad);
+    rows.load(qp);
+    for (j, (&l, &h)) in lo.iter().zip(hi).enumerate() {
+        set_box(qp, j, l, h);
+    }
+    used
+}
+
+/// Solves a loaded step QP of `n_u` input increments: on failure shrinks the
+/// trust region and returns the rejected step's report; otherwise the outcome,
+/// Clarabel's iterations and the decrease the quadratic model and the
+/// clearance penalty predict for the solution (read with `qp.solution()`).
+pub(crate) fn solve_layout(
+    qp: &mut Qp,
+    rows: &Clearance,
+    quad: &QuadModel,
+    n_u: usize,
+    trust: &mut TrustRegion,
+) -> Result<(QpOutcome, u32, f64), ScpReport> {
+    let outcome = qp.solve();
+    let iterations = qp.iterations();
+    if !outcome.is_usable() {
+        trust.fail();
+        return Err(ScpReport::rejected(
+            outcome,
+            quad.value,
+            trust.radius(),
+            iterations,
+        ));
+    }
+    let du = qp.solution();
+    let predicted = quad.predicted_decrease(&du[..n_u]) + rows.predicted_decrease(du);
+    Ok((outcome, iterations, predicted))
 }
 
 /// The obstacle terms of one predicted position `pos` (the state after sample

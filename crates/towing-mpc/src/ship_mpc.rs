@@ -43,11 +43,11 @@ use crate::formation::FormationMap;
 use crate::obstacle::{DistanceCost, Obstacle};
 use crate::qp::QpBuildError;
 use crate::scp::{
-    angle_difference, box_qp, condense, load_model, obstacle_terms, set_box, Clearance,
+    angle_difference, box_qp, condense, load_layout, obstacle_terms, solve_layout, Clearance,
     ClearanceParams, QuadModel, ScpReport, ScpSettings, TrustRegion,
 };
 use crate::ship::{ShipInput, ShipLinearisation, ShipModel, ShipState};
-use crate::tug_mpc::{rejected, HORIZON};
+use crate::tug_mpc::HORIZON;
 use crate::Qp;
 
 const N: usize = 4 * HORIZON;
@@ -134,6 +134,32 @@ pub struct TerminalCost {
     pub weight: f64,
     /// `tau` (s).
     pub horizon: f64,
+}
+
+impl ShipMpcParams {
+    /// `(lower, upper, rate)` of channel `k` (0, 1: tensions; 2, 3: angles):
+    /// eq. (17)-(18) and (20)-(21).
+    #[must_use]
+    pub fn channel_limits(&self, k: usize) -> (f64, f64, f64) {
+        if k < 2 {
+            (self.min_tension, self.max_tension, self.tension_rate)
+        } else {
+            (-self.max_angle, self.max_angle, self.angle_rate)
+        }
+    }
+
+    /// Projects `plan` onto the bounds and the rate bounds, sample by sample,
+    /// the first measured from `previous` (itself clamped to the bounds).
+    pub fn project(&self, plan: &mut [ShipInput; HORIZON], previous: &ShipInput) {
+        for k in 0..4 {
+            let (lo, hi, rate) = self.channel_limits(k);
+            let mut before = previous[k].clamp(lo, hi);
+            for u in plan.iter_mut() {
+                u[k] = u[k].clamp(lo.max(before - rate), hi.min(before + rate));
+                before = u[k];
+            }
+        }
+    }
 }
 
 /// The data of one step. Per sample `h`: `reference[h]`, `tug_poses[i][h]`,
@@ -289,16 +315,6 @@ impl ShipMpc {
         &mut self.trust
     }
 
-    /// `(lower, upper, rate)` of channel `k` (0, 1: tensions; 2, 3: angles).
-    fn limits(&self, k: usize) -> (f64, f64, f64) {
-        let p = &self.params;
-        if k < 2 {
-            (p.min_tension, p.max_tension, p.tension_rate)
-        } else {
-            (-p.max_angle, p.max_angle, p.angle_rate)
-        }
-    }
-
     /// The true cost of `plan` for `data` (nonlinear rollout).
     #[must_use]
     pub fn cost(&self, plan: &[ShipInput; HORIZON], data: &ShipStepData<'_>) -> f64 {
@@ -320,16 +336,9 @@ impl ShipMpc {
 
     /// One SCP step (module docs). Allocation-free.
     pub fn solve_step(&mut self, data: &ShipStepData<'_>) -> ScpReport {
-        let limits: [(f64, f64, f64); 4] = std::array::from_fn(|k| self.limits(k));
+        let limits: [(f64, f64, f64); 4] = std::array::from_fn(|k| self.params.channel_limits(k));
         // Project the plan onto the constraints.
-        for k in 0..4 {
-            let (lo, hi, rate) = limits[k];
-            let mut before = data.previous[k].clamp(lo, hi);
-            for u in &mut self.plan {
-                u[k] = u[k].clamp(lo.max(before - rate), hi.min(before + rate));
-                before = u[k];
-            }
-        }
+        self.params.project(&mut self.plan, &data.previous);
         let key = (data.state, self.plan);
         if self.lin_key != Some(key) {
             self.model
@@ -375,20 +384,16 @@ impl ShipMpc {
                 box_hi[4 * h + k] = r.max(0.0);
             }
         }
-        self.variants[full].1.drop_redundant(&box_lo, &box_hi);
-        let used = self.variants[full].1.slots_used();
-        if used < full {
-            let (small, large) = self.variants.split_at_mut(full);
-            small[used].1.copy_from(&large[0].1);
-        }
-        let (qp, clearance, rate_row) = &mut self.variants[used];
-        let rate_row = *rate_row;
+        let used = load_layout(
+            &mut self.variants,
+            ship_layout,
+            &self.quad,
+            &box_lo,
+            &box_hi,
+        );
         let cost_before = self.quad.value;
-        load_model(qp, &self.quad);
-        clearance.load(qp);
-        for j in 0..N {
-            set_box(qp, j, box_lo[j], box_hi[j]);
-        }
+        let (qp, rows, rate_row) = &mut self.variants[used];
+        let rate_row = *rate_row;
         for k in 0..4 {
             let rate = limits[k].2;
             for h in 1..HORIZON {
@@ -398,25 +403,17 @@ impl ShipMpc {
                 qp.b_mut()[row + 1] = (rate + diff).max(0.0);
             }
         }
-        let outcome = qp.solve();
-        let iterations = qp.iterations();
-        if !outcome.is_usable() {
-            self.trust.fail();
-            return rejected(outcome, cost_before, self.trust.radius(), iterations);
-        }
+        let (outcome, iterations, predicted) =
+            match solve_layout(qp, rows, &self.quad, N, &mut self.trust) {
+                Ok(solved) => solved,
+                Err(report) => return report,
+            };
         let du = qp.solution();
-        let predicted = self.quad.predicted_decrease(&du[..N]) + clearance.predicted_decrease(du);
         // The candidate, projected as the plan was (removes the solver's 1e-6
         // tolerance on the constraints).
-        for k in 0..4 {
-            let (lo, hi, rate) = limits[k];
-            let mut before = data.previous[k].clamp(lo, hi);
-            for h in 0..HORIZON {
-                let v = self.plan[h][k] + du[4 * h + k];
-                self.candidate[h][k] = v.clamp(lo.max(before - rate), hi.min(before + rate));
-                before = self.candidate[h][k];
-            }
-        }
+        self.candidate =
+            std::array::from_fn(|h| std::array::from_fn(|k| self.plan[h][k] + du[4 * h + k]));
+        self.params.project(&mut self.candidate, &data.previous);
         self.model
             .rollout_into(&data.state, &self.candidate, &mut self.candidate_states);
         self.quad.reset(true);
@@ -445,6 +442,11 @@ impl ShipMpc {
             iterations,
         )
     }
+}
+
+/// A coordination layout's QP and clearance rows.
+fn ship_layout(v: &mut (Qp, Clearance, usize)) -> (&mut Qp, &mut Clearance) {
+    (&mut v.0, &mut v.1)
 }
 
 /// The ship's own terms of eq. (13) at one predicted state `x` (after sample
@@ -632,12 +634,12 @@ mod tests {
         let tol = 1e-9;
         let mut before = *previous;
         for k in 0..4 {
-            let (lo, hi, _) = mpc.limits(k);
+            let (lo, hi, _) = mpc.params().channel_limits(k);
             before[k] = before[k].clamp(lo, hi);
         }
         for u in mpc.plan() {
             for k in 0..4 {
-                let (lo, hi, rate) = mpc.limits(k);
+                let (lo, hi, rate) = mpc.params().channel_limits(k);
                 if u[k] < lo - tol || u[k] > hi + tol {
                     return Err(format!("bound {k}: {u:?}"));
                 }

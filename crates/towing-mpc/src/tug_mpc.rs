@@ -46,9 +46,9 @@
 use nalgebra::Matrix6x3;
 
 use crate::obstacle::{DistanceCost, Obstacle};
-use crate::qp::{QpBuildError, QpOutcome};
+use crate::qp::QpBuildError;
 use crate::scp::{
-    angle_difference, box_qp, condense, load_model, obstacle_terms, set_box, Clearance,
+    angle_difference, box_qp, condense, load_layout, obstacle_terms, solve_layout, Clearance,
     ClearanceParams, QuadModel, ScpReport, ScpSettings, TrustRegion,
 };
 use crate::tug::{TowlinePull, TugInput, TugLinearisation, TugModel, TugState};
@@ -258,27 +258,15 @@ impl TugMpc {
                 hi[3 * h + c] = (lim[c] - u).min(tr);
             }
         }
-        self.variants[full].1.drop_redundant(&lo, &hi);
-        let used = self.variants[full].1.slots_used();
-        if used < full {
-            let (small, large) = self.variants.split_at_mut(full);
-            small[used].1.copy_from(&large[0].1);
-        }
-        let (qp, clearance) = &mut self.variants[used];
+        let used = load_layout(&mut self.variants, tug_layout, &self.quad, &lo, &hi);
         let cost_before = self.quad.value;
-        load_model(qp, &self.quad);
-        clearance.load(qp);
-        for j in 0..N {
-            set_box(qp, j, lo[j], hi[j]);
-        }
-        let outcome = qp.solve();
-        let iterations = qp.iterations();
-        if !outcome.is_usable() {
-            self.trust.fail();
-            return rejected(outcome, cost_before, self.trust.radius(), iterations);
-        }
+        let (qp, rows) = &mut self.variants[used];
+        let (outcome, iterations, predicted) =
+            match solve_layout(qp, rows, &self.quad, N, &mut self.trust) {
+                Ok(solved) => solved,
+                Err(report) => return report,
+            };
         let du = qp.solution();
-        let predicted = self.quad.predicted_decrease(&du[..N]) + clearance.predicted_decrease(du);
         for h in 0..HORIZON {
             for c in 0..3 {
                 self.candidate[h][c] = (self.plan[h][c] + du[3 * h + c]).clamp(-lim[c], lim[c]);
@@ -316,22 +304,9 @@ impl TugMpc {
     }
 }
 
-pub(crate) fn rejected(
-    outcome: QpOutcome,
-    cost_before: f64,
-    radius: f64,
-    qp_iterations: u32,
-) -> ScpReport {
-    ScpReport {
-        qp: outcome,
-        accepted: false,
-        cost_before,
-        cost_after: cost_before,
-        predicted_decrease: 0.0,
-        ratio: f64::NAN,
-        radius,
-        qp_iterations,
-    }
+/// A tug layout's QP and clearance rows.
+fn tug_layout(v: &mut (Qp, Clearance)) -> (&mut Qp, &mut Clearance) {
+    (&mut v.0, &mut v.1)
 }
 
 /// The cost terms of the states `states` (after samples 0..H); with `sens` the
