@@ -89,16 +89,7 @@ impl Measurement {
             ..Measurement::default()
         };
         for (k, slot) in m.obstacles.iter_mut().enumerate() {
-            let o = world.obstacle(k);
-            *slot = ObstacleInput {
-                x: o.x,
-                y: o.y,
-                psi: o.psi,
-                speed: o.speed,
-                length: o.length,
-                width: o.width,
-                kind: o.kind,
-            };
+            *slot = world.obstacle(k).into();
         }
         m
     }

@@ -93,6 +93,22 @@ pub struct ObstacleInput {
     pub kind: i32,
 }
 
+impl From<towing_model::ObstacleOutput> for ObstacleInput {
+    /// The plant's obstacle slot as the controller reads it (same fields, same
+    /// meaning: `docs/interface.md`).
+    fn from(o: towing_model::ObstacleOutput) -> Self {
+        ObstacleInput {
+            x: o.x,
+            y: o.y,
+            psi: o.psi,
+            speed: o.speed,
+            length: o.length,
+            width: o.width,
+            kind: o.kind,
+        }
+    }
+}
+
 impl ObstacleInput {
     /// Checks the input and returns the obstacle, or `None` for kind 0 (whose other
     /// fields are not looked at).
