@@ -395,10 +395,7 @@ def test_a_discarded_step_stops_the_run_with_the_plants_message(plant_fmu, contr
 # - Centralized, scheme III: the ship reaches the destination and holds it from about
 #   1000 s, then creeps forward from about 1120 s (both lines at the 0.1 N pretension),
 #   is pulled back, and has not settled again at 1200 s.
-KNOWN_FAILURES = {
-    (2, 1): "centralized scheme I: at rest for target A the heading drifts to port; A passes 2 deg to starboard (open, issue 3 note)",
-    (2, 3): "centralized scheme III leaves the destination again at about 1120 s (open, issue 3 note)",
-}
+KNOWN_FAILURES = {}
 CASES = [
     pytest.param(a, s, marks=pytest.mark.xfail(strict=True, reason=KNOWN_FAILURES[(a, s)]))
     if (a, s) in KNOWN_FAILURES

@@ -186,6 +186,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(v) = env("TUG_TR_N") {
         config.tug.trust_scale[2] = v;
     }
+    if let Some(v) = env("PT_W") {
+        config.ship.port_turn_weight = v;
+    }
+    if let Some(v) = env("PT_M") {
+        config.tracking.port_turn_margin = v.to_radians();
+    }
+    if let Some(v) = env("TUG_RW") {
+        config.centralized.thrust_rate_weight = v;
+    }
     if let Some(v) = env("CENT_IT") {
         config.centralized.max_iterations = v as usize;
     }

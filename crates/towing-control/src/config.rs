@@ -142,17 +142,26 @@ pub struct TrackingParams {
     /// equal; off the route (after an avoidance) the printed heading and a short
     /// horizon leave the ship in a local minimum beside its waypoint.
     pub los_distance: f64,
+    /// Port-turn margin (rad) of the heading floor: while an encounter in which
+    /// the tow may not turn to port is under way (head-on, Rule 14; crossing,
+    /// Rules 15 and 17(c)) and the scheme alters waypoints (I, II), the ship's
+    /// predicted heading is kept to starboard of its heading at the start of
+    /// the encounter minus this margin
+    /// ([`towing_mpc::ShipMpcParams::port_turn_weight`]).
+    pub port_turn_margin: f64,
 }
 
 impl Default for TrackingParams {
     /// `lookahead = 3.5 m`, `give_way_lookahead = 0 m`, `los_distance = 2.5 m`
-    /// (two CyberShip II lengths);
+    /// (two CyberShip II lengths), `port_turn_margin = 2 deg` (the course change
+    /// evaluators count as none, `docs/colregs.md`);
     /// why in `docs/assumptions.md`.
     fn default() -> Self {
         TrackingParams {
             lookahead: 3.5,
             give_way_lookahead: 0.0,
             los_distance: 2.5,
+            port_turn_margin: 2f64.to_radians(),
         }
     }
 }
@@ -254,6 +263,12 @@ impl ControllerConfig {
             ("lookahead", self.tracking.lookahead),
             ("give_way_lookahead", self.tracking.give_way_lookahead),
             ("los_distance", self.tracking.los_distance),
+            ("port_turn_margin", self.tracking.port_turn_margin),
+            ("port_turn_weight", self.ship.port_turn_weight),
+            (
+                "centralized_thrust_rate_weight",
+                self.centralized.thrust_rate_weight,
+            ),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(ConfigError::new(

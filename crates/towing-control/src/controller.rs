@@ -28,7 +28,7 @@ use towing_guidance::{
     body_to_ned, role, GuidanceOutput, GuidanceParams, ObstacleInput, Pose, ReferenceSystem, Role,
     Situation, TowState,
 };
-use towing_model::{VesselData, VesselState, World, MAX_OBSTACLES};
+use towing_model::{wrap_angle, VesselData, VesselState, World, MAX_OBSTACLES};
 use towing_mpc::{
     Admm, AppliedCommand, Centralized, Obstacle, QpOutcome, SampleInput, ShipInput, ShipModel,
     ShipState, TugInput, TugState, HORIZON,
@@ -153,6 +153,9 @@ pub struct SampleReport {
     pub fallback: Option<Fallback>,
     /// Fallbacks since instantiation.
     pub fallbacks: u64,
+    /// The heading floor of this sample (rad; `None`: none): no turn to port
+    /// during a head-on or crossing encounter ([`TrackingParams::port_turn_margin`]).
+    pub heading_floor: Option<f64>,
     /// Predicted trajectories of the plan.
     pub prediction: Prediction,
 }
@@ -202,6 +205,9 @@ pub struct Controller {
     nu_end: [[f64; 3]; 2],
     fallbacks: u64,
     mpc_obstacles: [Obstacle; MAX_OBSTACLES],
+    /// Per obstacle slot: the ship's heading when an encounter began in which
+    /// the tow may not turn to port ([`TrackingParams::port_turn_margin`]).
+    port_turn_anchor: [Option<f64>; MAX_OBSTACLES],
 }
 
 fn mass_matrix(d: &VesselData) -> [[f64; 3]; 3] {
@@ -285,6 +291,7 @@ impl Controller {
                 centre: [0.0; 2],
                 radius: 1.0,
             }; MAX_OBSTACLES],
+            port_turn_anchor: [None; MAX_OBSTACLES],
         })
     }
 
@@ -358,6 +365,7 @@ impl Controller {
                 };
             }
         }
+        let heading_floor = self.heading_floor(m.ship[2]);
         let n_obstacles = self.select_obstacles(m);
         let input = SampleInput {
             ship: m.ship,
@@ -365,6 +373,7 @@ impl Controller {
             previous: self.applied,
             reference: [reference; HORIZON],
             obstacles: &self.mpc_obstacles[..n_obstacles],
+            heading_floor,
         };
         let report = self.solver.solve(&input);
         let ship_plan = *self.solver.ship_plan();
@@ -430,6 +439,7 @@ impl Controller {
             compute_time: start.elapsed().as_secs_f64(),
             fallback,
             fallbacks: self.fallbacks,
+            heading_floor,
             prediction,
         })
     }
@@ -523,6 +533,49 @@ impl Controller {
             goal[2] = dy.atan2(dx);
         }
         goal
+    }
+
+    /// The heading floor of this sample (`None`: none), after updating the
+    /// encounters' anchors from the guidance's situations.
+    ///
+    /// COLREGS: in a head-on situation (Rule 14) and a crossing in which the tow
+    /// gives way (Rule 15) the tow alters to starboard; in a crossing in which
+    /// it stands on it must not turn to port for the vessel on its port side
+    /// (Rule 17(c)). In all three the tow therefore never turns to port: the
+    /// heading at the start of the encounter, less
+    /// [`TrackingParams::port_turn_margin`], is a floor for the ship's predicted
+    /// headings until the situation ends (the range opens). Without it the
+    /// centralized MPC, trading the heading error against the tugs' distance
+    /// terms of (16), let the stopped tow swing 40 deg to port while giving way
+    /// to target A (`docs/controller-design.md`). Scheme III (distance cost
+    /// only, no COLREGS logic) has no floor, as in the paper.
+    fn heading_floor(&mut self, psi: f64) -> Option<f64> {
+        let alters = self.config.scheme.alters();
+        let mut floor: Option<f64> = None;
+        for k in 0..MAX_OBSTACLES {
+            let binding = alters
+                && matches!(
+                    self.guidance.situation(k),
+                    Some(
+                        Situation::HeadOn | Situation::CrossingGiveWay | Situation::CrossingStandOn
+                    )
+                );
+            if !binding {
+                self.port_turn_anchor[k] = None;
+                continue;
+            }
+            // Ratchet: a starboard alteration is not taken back before the
+            // situation ends (Rule 8(d): until the target is past and clear).
+            let anchor = match self.port_turn_anchor[k] {
+                Some(a) if wrap_angle(a - psi) > 0.0 => a,
+                _ => psi,
+            };
+            self.port_turn_anchor[k] = Some(anchor);
+            // Relative to the current heading, so that wrapping cannot matter.
+            let limit = wrap_angle(anchor - psi) - self.config.tracking.port_turn_margin;
+            floor = Some(floor.map_or(limit, |f: f64| f.max(limit)));
+        }
+        floor.map(|f| psi + f)
     }
 
     /// The inner loop's parameters.

@@ -264,3 +264,55 @@ fn a_failed_solve_applies_the_shifted_plan_within_bounds_then_comes_to_rest() {
     let r = c.sample(&m).unwrap();
     assert!(r.fallback.is_none(), "{:?}", r.fallback);
 }
+
+/// A target crossing from starboard (give-way): in schemes I and II the ship's
+/// heading at the start of the encounter, less the margin, becomes a floor; it
+/// ratchets up with the heading, lifts when the situation ends, and scheme III
+/// has none.
+#[test]
+fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
+    let (scenario, mut m) = paper_measurement();
+    let psi = m.ship[2];
+    // 5 m ahead and 3 m to starboard, heading across the bow to port, closing.
+    let (fwd, stb) = (5.0, 3.0);
+    let target = ObstacleInput {
+        x: m.ship[0] + fwd * psi.cos() - stb * psi.sin(),
+        y: m.ship[1] + fwd * psi.sin() + stb * psi.cos(),
+        psi: psi - std::f64::consts::FRAC_PI_2,
+        speed: 0.07,
+        length: 1.48,
+        width: 0.48,
+        kind: 2,
+    };
+    m.obstacles[3] = target;
+    let margin = ControllerConfig::new(scenario.clone()).tracking.port_turn_margin;
+    let controller = |scheme| {
+        let mut config = ControllerConfig::new(scenario.clone());
+        config.scheme = scheme;
+        Controller::new(config).unwrap()
+    };
+    let mut c = controller(AvoidanceScheme::AlterAndCost);
+    let r = c.sample(&m).unwrap();
+    assert_eq!(r.role[3], 1, "give-way");
+    let floor = r.heading_floor.expect("a floor while giving way");
+    assert!((floor - (psi - margin)).abs() < 1e-12, "{floor} vs {psi}");
+
+    // The ship has turned 10 deg to starboard: the floor follows.
+    let mut turned = m.clone();
+    turned.ship[2] = psi + 10f64.to_radians();
+    let r = c.sample(&turned).unwrap();
+    let up = r.heading_floor.unwrap();
+    assert!((up - (turned.ship[2] - margin)).abs() < 1e-12);
+    // Back at the old heading the floor stays up (no port turn is taken back).
+    let r = c.sample(&m).unwrap();
+    assert!((r.heading_floor.unwrap() - up).abs() < 1e-12);
+
+    // The target gone: no floor.
+    let mut clear = m.clone();
+    clear.obstacles[3].kind = 0;
+    assert_eq!(c.sample(&clear).unwrap().heading_floor, None);
+
+    // Scheme III: no COLREGS logic, no floor.
+    let mut three = controller(AvoidanceScheme::CostOnly);
+    assert_eq!(three.sample(&m).unwrap().heading_floor, None);
+}

@@ -46,6 +46,7 @@ fn bench(c: &mut Criterion) {
             previous: AppliedCommand::default(),
             reference,
             obstacles: &obstacles,
+            heading_floor: None,
         };
         let mut admm = Admm::from_scenario(
             &scenario,
@@ -88,6 +89,7 @@ fn bench(c: &mut Criterion) {
             previous: AppliedCommand::default(),
             reference,
             obstacles,
+            heading_floor: None,
         };
         let mut central = Centralized::from_scenario(
             &scenario,

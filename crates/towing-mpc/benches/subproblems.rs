@@ -74,6 +74,7 @@ fn bench(c: &mut Criterion) {
         lambda: [[[0.05; 3]; HORIZON]; 2],
         rho: 1.0,
         obstacles: &obstacles,
+        heading_floor: None,
     };
     let ship_plan = [[0.5, 1.0, 0.0, 0.0]; HORIZON];
     c.bench_function("ship_scp_step", |b| {

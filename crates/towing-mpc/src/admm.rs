@@ -180,6 +180,10 @@ pub struct SampleInput<'a> {
     pub reference: [[f64; 3]; HORIZON],
     /// Static obstacles.
     pub obstacles: &'a [Obstacle],
+    /// The lowest heading the ship may take over the horizon (rad): COLREGS,
+    /// no turn to port while giving way or standing on
+    /// ([`crate::ShipMpcParams::port_turn_weight`]); `None`: no such limit.
+    pub heading_floor: Option<f64>,
 }
 
 /// Residuals and tolerances of one iteration (per tug).
@@ -454,6 +458,7 @@ impl Admm {
                 lambda: self.lambda,
                 rho: s.rho,
                 obstacles: input.obstacles,
+                heading_floor: input.heading_floor,
             };
             let report = self.ship.solve_step(&data);
             failed_steps += usize::from(!report.qp.is_usable());

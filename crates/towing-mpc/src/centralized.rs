@@ -125,6 +125,10 @@ pub struct CentralizedSettings {
     pub max_consensus_slack: f64,
     /// Trust region (scales: the subproblems' `trust_scale`).
     pub scp: ScpSettings,
+    /// `w_dtau`: weight of the tugs' thrust changes
+    /// `sum_i sum_h |tau_ih - tau_ih-1|^2` (per N^2 and (N m)^2), `tau_i,-1` the
+    /// thrust applied in the previous sample; see [`thrust_rate_terms`].
+    pub thrust_rate_weight: f64,
 }
 
 impl Default for CentralizedSettings {
@@ -135,6 +139,53 @@ impl Default for CentralizedSettings {
             consensus_penalty: 1e3,
             max_consensus_slack: 10.0,
             scp: ScpSettings::default(),
+            thrust_rate_weight: 0.01,
+        }
+    }
+}
+
+/// `w sum_h |tau_h - tau_h-1|^2` over one tug's plan, `tau_-1 = previous`, with
+/// `column(h, c)` the increment variable of channel `c` of sample `h` (the
+/// variables are increments of the plan, so the rows are unit vectors).
+///
+/// Why, and why only here: in the centralized problem the configuration
+/// restriction `g_i = f_i` holds at every sample, three equalities per sample
+/// against a tug's three thrusts, so the tugs' thrusts are slaved to the ship's
+/// plan, and the cost of (16) has no input term. A TitoNeri's sway force and
+/// yaw moment have a combination that barely moves the pose at the sample
+/// instants of a 3-step horizon; nothing fixed it, and in the closed loop tug
+/// 1's sway thrust alternated in sign from sample to sample and grew from 1.8 N
+/// to 7 N within 40 s, until the tow crept off its destination (scheme III) or
+/// swung to port while giving way (scheme I) (`docs/controller-design.md`).
+/// A move-suppression term is the standard remedy (Maciejowski 2002, Predictive
+/// Control with Constraints, section 3.1, the weight on input changes). The
+/// distributed controller does not need it (the ADMM's penalty `rho` keeps
+/// the consensus soft within an iteration, and no such alternation was seen),
+/// and there it slowed the ADMM's convergence on the paper instance tenfold,
+/// so it is not in [`crate::TugMpc`]: with `w > 0` the two architectures solve
+/// problems that differ by this term (`tests::distributed_matches_centralized`
+/// sets it to 0).
+fn thrust_rate_terms(
+    quad: &mut QuadModel,
+    weight: f64,
+    plan: &[TugInput; HORIZON],
+    previous: TugInput,
+    column: impl Fn(usize, usize) -> usize,
+) {
+    if weight <= 0.0 {
+        return;
+    }
+    for h in 0..HORIZON {
+        let before = if h == 0 { previous } else { plan[h - 1] };
+        for c in 0..3 {
+            let mut row = [0.0; NU];
+            if !quad.value_only {
+                row[column(h, c)] = 1.0;
+                if h > 0 {
+                    row[column(h - 1, c)] = -1.0;
+                }
+            }
+            quad.residual(plan[h][c] - before[c], weight, 0.0, &row);
         }
     }
 }
@@ -382,6 +433,7 @@ impl Problem {
                 &rows,
                 with_rows.then(|| std::array::from_fn(|k| ship_var(h, k))),
                 h + 1 == HORIZON,
+                input.heading_floor,
             );
             obstacle_terms(
                 quad,
@@ -425,6 +477,15 @@ impl Problem {
                     }
                     quad.residual(res[c], tp.weights[0], 0.0, &cons.rows[m]);
                     quad.residual(g[3 + c], tp.weights[1], 0.0, &rows[3 + c]);
+                }
+                if h == 0 {
+                    thrust_rate_terms(
+                        quad,
+                        self.settings.thrust_rate_weight,
+                        &plan.tugs[i],
+                        input.previous.tugs[i],
+                        |h, c| tug_var(i, h, c),
+                    );
                 }
                 obstacle_terms(
                     quad,

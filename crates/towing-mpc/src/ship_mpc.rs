@@ -96,6 +96,11 @@ pub struct ShipMpcParams {
     pub distance: DistanceCost,
     /// Hard clearance rows.
     pub clearance: ClearanceParams,
+    /// `w_P`: weight of the one-sided heading term `w_P min(0, psi_h - psi_floor)^2`
+    /// (per rad^2), active only when the sample carries a heading floor
+    /// ([`ShipStepData::heading_floor`]). Not in the paper: see
+    /// [`ship_stage_terms`].
+    pub port_turn_weight: f64,
 }
 
 impl Default for ShipMpcParams {
@@ -118,6 +123,7 @@ impl Default for ShipMpcParams {
             scp: ScpSettings::default(),
             distance: DistanceCost::default(),
             clearance: ClearanceParams::with_min_distance(0.75),
+            port_turn_weight: 100.0,
         }
     }
 }
@@ -180,6 +186,9 @@ pub struct ShipStepData<'a> {
     pub rho: f64,
     /// Static obstacles.
     pub obstacles: &'a [Obstacle],
+    /// The lowest heading the ship may take over the horizon (rad), from
+    /// COLREGS: no turn to port while the tow gives way or stands on.
+    pub heading_floor: Option<f64>,
 }
 
 /// The coordination MPC (module docs).
@@ -466,8 +475,16 @@ pub(crate) fn ship_stage_terms<const N: usize>(
     rows: &[[f64; N]; 6],
     columns: Option<[usize; 4]>,
     last: bool,
+    heading_floor: Option<f64>,
 ) {
     let [w1, w2, _] = params.weights;
+    if let Some(floor) = heading_floor {
+        // One-sided: zero (with its gradient) at or to starboard of the floor.
+        let e = angle_difference(x[2], floor);
+        if e < 0.0 {
+            quad.curved(e * e, 2.0 * e, 2.0, params.port_turn_weight, &rows[2]);
+        }
+    }
     let err = [
         x[0] - reference[0],
         x[1] - reference[1],
@@ -553,6 +570,7 @@ fn accumulate(
             &rows,
             sens.is_some().then_some(columns),
             h + 1 == HORIZON,
+            data.heading_floor,
         );
         for i in 0..2 {
             let (f, jac) = formation.tug_reference_linearised(eta, plan[h][2 + i], i);
@@ -626,6 +644,7 @@ mod tests {
             lambda: [[[0.0; 3]; HORIZON]; 2],
             rho,
             obstacles: &[],
+            heading_floor: None,
         }
     }
 
@@ -698,6 +717,33 @@ mod tests {
         assert!(total(1) > total(0), "{plan:?}");
         let states = mpc.predicted_states();
         assert!(states[HORIZON - 1][0] > 0.0 && states[HORIZON - 1][3] > 0.0);
+    }
+
+    /// A reference to port turns the ship to port; a heading floor at the
+    /// current heading keeps its predicted headings (nearly) to starboard of it,
+    /// and a floor below every predicted heading changes nothing.
+    #[test]
+    fn a_heading_floor_stops_a_turn_to_port() {
+        let run = |floor: Option<f64>| {
+            let mut mpc = ship_mpc_with(ShipMpcParams {
+                port_turn_weight: 1e4,
+                ..ShipMpcParams::default()
+            });
+            let mut data = data_at_rest(&mpc, [1.0, -1.0, -0.5], 0.0);
+            data.heading_floor = floor;
+            for _ in 0..40 {
+                assert!(mpc.solve_step(&data).qp.is_usable());
+            }
+            mpc.predicted_states().map(|x| x[2])
+        };
+        let free = run(None);
+        assert!(free[HORIZON - 1] < -1e-3, "{free:?}");
+        let held = run(Some(0.0));
+        assert!(held.iter().all(|&psi| psi > -1e-3), "{held:?}");
+        let low = run(Some(-1.0));
+        for (a, b) in free.iter().zip(low) {
+            assert!((a - b).abs() < 1e-9, "{free:?} vs {low:?}");
+        }
     }
 
     /// g_2 displaced to starboard (+y at heading North) pulls alpha_2 positive.

@@ -47,6 +47,7 @@ fn paper_input(obstacles: &[Obstacle]) -> SampleInput<'_> {
         previous: AppliedCommand::default(),
         reference: reference_ahead(&ship, 2.0),
         obstacles,
+        heading_floor: None,
     }
 }
 
@@ -136,6 +137,7 @@ fn plant_like_next<'a>(a: &Admm, input: &SampleInput<'a>, r: &AdmmReport) -> Sam
         },
         reference: reference_ahead(&ship, 2.0),
         obstacles: input.obstacles,
+        heading_floor: None,
     }
 }
 

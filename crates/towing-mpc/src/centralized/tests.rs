@@ -47,6 +47,7 @@ fn instance(ahead: f64, lateral: f64, turn: f64, d: f64) -> SampleInput<'static>
         },
         reference: [target; HORIZON],
         obstacles: &[],
+        heading_floor: None,
     }
 }
 
@@ -83,6 +84,9 @@ fn tight_settings() -> CentralizedSettings {
     CentralizedSettings {
         max_iterations: 200,
         tolerance: 1e-7,
+        // The same problem as the ADMM's (no move suppression, see
+        // `thrust_rate_terms`).
+        thrust_rate_weight: 0.0,
         ..CentralizedSettings::default()
     }
 }
