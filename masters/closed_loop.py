@@ -32,6 +32,8 @@ Options:
     --param NAME=VALUE              any controller parameter, typed from its
                                     modelDescription (repeatable)
     --plant-param NAME=VALUE        the same for the plant (e.g. hull_model=1)
+    --log-dir DIR                   MCAP logs (docs/logging.md): sets `log_file` to
+                                    DIR/plant.mcap and DIR/controller.mcap (created)
     --out DIR (out/closed-loop), --map-size WxH (pixels, 1400x1200), --quiet
 
 Writes:
@@ -44,8 +46,12 @@ Writes:
     DIR/map.png         East horizontal, North vertical, equal aspect: route, ship and tug
                         tracks, static hazards and target ships at real size, vessel
                         outlines every ~100 s, start and end markers.
-    DIR/summary.json    stop time, wall time, steps, fallbacks, warnings, compute time and
-                        ADMM iteration statistics over the controller samples, final ship pose.
+    DIR/summary.json    stop time, wall time (and the master thread's CPU time) of the
+                        stepping loop, steps, fallbacks, warnings, compute time and
+                        ADMM iteration statistics over the controller samples, final ship pose,
+                        the log files (with --log-dir).
+    LOG/plant.mcap, LOG/controller.mcap   with --log-dir LOG; open both in Foxglove
+                        (docs/foxglove.md).
 
 fmpy's FMU2Slave raises FMICallException for every status above fmi2Warning and returns
 warnings silently; this master calls fmi2DoStep itself to see the status, counts warnings
@@ -317,6 +323,15 @@ def run(args, log):
             ctrl.set_parameter(name, value)
         for name, value in parse_assignments(args.plant_param):
             plant.set_parameter(name, value)
+        log_files = {}
+        if args.log_dir:
+            log_dir = pathlib.Path(args.log_dir).resolve()
+            log_dir.mkdir(parents=True, exist_ok=True)
+            for u, file_name in ((plant, "plant.mcap"), (ctrl, "controller.mcap")):
+                if "log_file" not in u.vars:
+                    raise UsageError(f"{u.name} has no parameter 'log_file' (needed by --log-dir)")
+                log_files[u.name] = str(log_dir / file_name)
+                u.set_parameter("log_file", log_files[u.name])
 
         # Columns: time, plant outputs, controller outputs (modelDescription order).
         columns = ["time"] + [v.name for v in plant.outputs] + [v.name for v in ctrl.outputs]
@@ -360,6 +375,7 @@ def run(args, log):
 
         fallback_col = col.get(FALLBACKS)
         wall0 = time.perf_counter()
+        cpu0 = time.thread_time()
         next_progress = PROGRESS_EVERY
         for k in range(n_steps):
             t = times[k]
@@ -384,8 +400,13 @@ def run(args, log):
                 )
         wall = time.perf_counter() - wall0
         summary = make_summary(columns, data, stop, wall, n_steps, warnings, log, ctrl, h)
+        # CPU time of the master's thread over the stepping loop: the FMUs' own work and the
+        # master's, without other threads (e.g. the FMUs' log writers) and other processes.
+        summary["loop_thread_cpu_time_s"] = time.thread_time() - cpu0
         summary["architecture"] = args.architecture if args.architecture is not None else _start(ctrl, "architecture")
         summary["avoidance_scheme"] = args.scheme if args.scheme is not None else _start(ctrl, "avoidance_scheme")
+        if log_files:
+            summary["log_files"] = log_files
         for u in units:
             u.free(terminate=True)
         return columns, data, summary, plant.unzipdir, workdir
@@ -629,6 +650,7 @@ def build_parser():
     p.add_argument("--scheme", type=int, choices=(1, 2, 3), help="controller `avoidance_scheme`: scheme I, II or III of Du et al. (2022) (default: the FMU's start value)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", default=[], help="set any controller parameter, typed from its modelDescription (repeatable)")
     p.add_argument("--plant-param", action="append", metavar="NAME=VALUE", default=[], help="set a plant parameter, e.g. hull_model=1 (repeatable)")
+    p.add_argument("--log-dir", default=None, metavar="DIR", help="write MCAP logs DIR/plant.mcap and DIR/controller.mcap (the FMUs' `log_file` parameters; default: no logs)")
     p.add_argument("--out", default="out/closed-loop", metavar="DIR", help="output directory (default: out/closed-loop)")
     p.add_argument("--map-size", type=parse_size, default=(1400, 1200), metavar="WxH", help="size of map.png in pixels (default: 1400x1200)")
     p.add_argument("--quiet", action="store_true", help="no progress lines (one every 100 s of simulated time otherwise)")

@@ -14,11 +14,16 @@
 //! on the current velocities, the tensions held. The outputs after `fmi2DoStep(t, h)` are the
 //! command for the plant's step starting at `t` (docs/interface.md, "Controller FMU").
 //!
+//! MCAP log (docs/logging.md): with `log_file` set, the file is created when initialization
+//! ends and gets every topic at each control sample; terminate closes it (a failure is
+//! `fmi2Error`), and `fmi2FreeInstance` closes it if terminate did not.
+//!
 //! FMU state: the solvers' warm starts and factorisations cannot be copied, so the FMU
 //! declares `canGetAndSetFMUstate="false"`. The layer still clones the model on
 //! `fmi2GetFMUstate`; a clone carries no controller, and an instance restored from one
 //! refuses to step with a message saying why (never a silent cold start).
 
+use crate::logging::{self, Sample};
 use crate::variables::{self as vars, Tunables, NO_OBSTACLE_DISTANCE, REAL_PARAMETERS};
 use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome};
 use std::path::{Path, PathBuf};
@@ -26,6 +31,7 @@ use towing_control::{
     Architecture, AvoidanceScheme, Command, Controller, ControllerConfig, Measurement, SampleReport,
 };
 use towing_interface::ScenarioFile;
+use towing_log::{LogOptions, LogWriter, RunInfo, SharedLog};
 use towing_model::{HullModel, Scenario, MAX_OBSTACLES};
 use towing_mpc::HORIZON;
 
@@ -70,12 +76,6 @@ impl Parameters {
     /// The controller configuration for `scenario`: `ControllerConfig::new`'s defaults,
     /// overridden by every parameter, each checked on its own first.
     fn config(&self, scenario: Scenario) -> Result<ControllerConfig, String> {
-        if !self.log_file.is_empty() {
-            return Err(format!(
-                "parameter `log_file`: MCAP logging arrives with the logging issue; must be empty for now, got {:?}",
-                self.log_file
-            ));
-        }
         let hull = match self.hull_model {
             0 => scenario.world_config.hull_model,
             1 => HullModel::LinearDamping,
@@ -312,6 +312,11 @@ pub struct ControllerFmu {
     /// This value is a copy made by `fmi2GetFMUstate` of an initialized instance: it has
     /// no controller and refuses to step.
     copied_without_controller: bool,
+    /// The scenario text as loaded (for the log's attachment).
+    scenario_text: String,
+    /// The MCAP log, open from the end of initialization while `log_file` is set (shared
+    /// with copies).
+    log: SharedLog,
 }
 
 impl Clone for ControllerFmu {
@@ -328,6 +333,8 @@ impl Clone for ControllerFmu {
             controller: None,
             clock: self.clock,
             copied_without_controller: self.controller.is_some() || self.copied_without_controller,
+            scenario_text: self.scenario_text.clone(),
+            log: self.log.clone(),
         }
     }
 }
@@ -336,13 +343,66 @@ impl ControllerFmu {
     /// Reads the scenario named by the `scenario` parameter (or the bundled one).
     fn load(&mut self, log: &Logger) -> Result<(), String> {
         let ScenarioFile {
-            origin, scenario, ..
+            origin,
+            scenario,
+            text,
         } = ScenarioFile::load(&self.params.scenario, self.resource_dir.as_deref())?;
         log.info(
             "logEvents",
             &format!("scenario '{}' loaded from {origin}", scenario.name),
         );
         self.scenario = Some(scenario);
+        self.scenario_text = text;
+        Ok(())
+    }
+
+    /// Creates the log named by `log_file` (if any) and writes the run description.
+    fn open_log(&mut self, log: &Logger) -> Result<(), String> {
+        if self.params.log_file.is_empty() {
+            return Ok(());
+        }
+        let mut writer = LogWriter::create(&self.params.log_file, LogOptions::default())
+            .map_err(|e| format!("parameter `log_file`: {e}"))?;
+        let guid = vars::DESCRIPTION.guid();
+        let p = &self.params;
+        let mut parameters = serde_json::Map::new();
+        parameters.insert("scenario".into(), p.scenario.clone().into());
+        parameters.insert("log_file".into(), p.log_file.clone().into());
+        for (name, value) in [
+            ("hull_model", p.hull_model),
+            ("architecture", p.architecture),
+            ("avoidance_scheme", p.avoidance_scheme),
+            ("max_iterations", p.max_iterations),
+            ("prediction_horizon", p.prediction_horizon),
+        ] {
+            parameters.insert(name.into(), value.into());
+        }
+        for (rp, &value) in REAL_PARAMETERS.iter().zip(&p.reals) {
+            parameters.insert(rp.name.into(), value.into());
+        }
+        let info = RunInfo {
+            unit: vars::MODEL_IDENTIFIER,
+            guid: &guid,
+            version: env!("CARGO_PKG_VERSION"),
+            scenario: &p.scenario,
+            scenario_name: self.scenario.as_ref().map_or("", |s| s.name.as_str()),
+            start_time: self.clock.start_time,
+            parameters: serde_json::Value::Object(parameters),
+            scenario_text: &self.scenario_text,
+        };
+        let written = writer
+            .write_run(&info)
+            .and_then(|()| logging::register_topics(&mut writer));
+        if let Err(e) = written {
+            let _ = writer.finish();
+            return Err(format!("parameter `log_file`: {e}"));
+        }
+        // From here on the messages are serialized and written on the log's own thread.
+        self.log = SharedLog::spawn(writer).map_err(|e| format!("parameter `log_file`: {e}"))?;
+        log.info(
+            "logEvents",
+            &format!("MCAP log {} created", self.params.log_file),
+        );
         Ok(())
     }
 
@@ -388,6 +448,8 @@ impl Fmi2Model for ControllerFmu {
             controller: None,
             clock: Clock::default(),
             copied_without_controller: false,
+            scenario_text: String::new(),
+            log: SharedLog::none(),
         })
     }
 
@@ -439,7 +501,7 @@ impl Fmi2Model for ControllerFmu {
                 self.params.architecture, self.params.avoidance_scheme
             ),
         );
-        Ok(())
+        self.open_log(log)
     }
 
     fn get_real(&self, vr: u32) -> f64 {
@@ -543,7 +605,7 @@ impl Fmi2Model for ControllerFmu {
                 Ok(())
             }
             vars::LOG_FILE => {
-                self.params.log_file = value.to_owned();
+                value.clone_into(&mut self.params.log_file);
                 Ok(())
             }
             _ => Err(format!("value reference {vr} is not a settable String")),
@@ -564,9 +626,13 @@ impl Fmi2Model for ControllerFmu {
         // The layer's clock is whole nanoseconds since the start time; recover them.
         let now_ns = ((step.current_time - self.clock.start_time) * 1e9).round() as i64;
         let mut outcome = StepOutcome::Ok;
+        let mut sampled = None;
         if now_ns + SAMPLE_TOLERANCE_NS >= self.clock.next_sample_ns {
             match controller.sample(&self.inputs.measurement) {
                 Ok(report) => {
+                    if self.log.is_active() {
+                        sampled = Some(report);
+                    }
                     self.outputs.record(&report);
                     self.clock.last_sample_ns = now_ns;
                     while self.clock.next_sample_ns <= now_ns + SAMPLE_TOLERANCE_NS {
@@ -597,11 +663,48 @@ impl Fmi2Model for ControllerFmu {
                 ))
             }
         }
+        if let Some(report) = sampled {
+            let warning = match &outcome {
+                StepOutcome::Warning(m) => Some(m.clone()),
+                _ => None,
+            };
+            let sample = Sample {
+                t: step.current_time,
+                report,
+                measurement: self.inputs.measurement,
+                command: self.outputs.command,
+                d_ob: self.outputs.d_ob,
+                samples: u64::try_from(self.outputs.samples).unwrap_or(0),
+                architecture: self.params.architecture,
+                scheme: self.params.avoidance_scheme,
+                scheme_alters: AvoidanceScheme::from_code(self.params.avoidance_scheme)
+                    .is_ok_and(AvoidanceScheme::alters),
+                warning,
+            };
+            let failed = self
+                .log
+                .batch(Box::new(move |w| logging::write_sample(w, &sample)));
+            if let Some(failed) = failed {
+                outcome = match outcome {
+                    StepOutcome::Warning(m) => StepOutcome::Warning(format!("{m}; {failed}")),
+                    _ => StepOutcome::Warning(failed),
+                };
+            }
+        }
         outcome
     }
 
     fn terminate(&mut self, _log: &Logger) -> Result<(), String> {
-        Ok(())
+        self.log
+            .finish()
+            .map(drop)
+            .map_err(|e| format!("closing the log: {e}"))
+    }
+
+    fn release(&mut self, log: &Logger) {
+        if let Err(e) = self.log.finish() {
+            log.error(&format!("closing the log: {e}"));
+        }
     }
 
     /// Writes only a marker: the state is not serialisable (`canSerializeFMUstate="false"`),

@@ -7,6 +7,7 @@
 #![deny(unsafe_code)]
 
 pub mod controller;
+pub mod logging;
 pub mod variables;
 
 pub use controller::ControllerFmu;

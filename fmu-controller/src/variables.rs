@@ -28,17 +28,17 @@ use towing_interface::variables::{
 };
 use towing_interface::{ModelInfo, RealType, VESSELS};
 use towing_model::MAX_OBSTACLES;
-use towing_mpc::{AdmmSettings, PredictionParams, ShipMpcParams, TugMpcParams, HORIZON};
+use towing_mpc::{
+    AdmmSettings, CentralizedSettings, PredictionParams, ShipMpcParams, TugMpcParams, HORIZON,
+};
 
 /// The model identifier (binary name).
 pub const MODEL_IDENTIFIER: &str = "TowingController";
 
 pub use towing_interface::vr::{
-    obstacle, tension_cmd, towline, tug_force, vessel_state, OBSTACLE_KIND, SCENARIO,
+    obstacle, tension_cmd, towline, tug_force, vessel_state, LOG_FILE, OBSTACLE_KIND, SCENARIO,
 };
 
-/// `log_file` (String parameter): reserved for the MCAP log; must be empty for now.
-pub const LOG_FILE: u32 = 2;
 /// `hull_model` (Integer parameter): 0 as the scenario, 1 linear, 2 nonlinear damping.
 pub const HULL_MODEL: u32 = 3;
 /// `architecture` (Integer parameter): 1 distributed, 2 centralized.
@@ -130,6 +130,8 @@ pub struct Tunables {
     pub ship: ShipMpcParams,
     /// Tug problems.
     pub tug: TugMpcParams,
+    /// Centralized problem (architecture 2).
+    pub centralized: CentralizedSettings,
     /// Reference system.
     pub guidance: GuidanceSettings,
     /// The tugs' inner loop.
@@ -147,6 +149,7 @@ impl Tunables {
             admm: config.admm,
             ship: config.ship,
             tug: config.tug,
+            centralized: config.centralized,
             guidance: config.guidance,
             inner: config.inner,
             tracking: config.tracking,
@@ -159,6 +162,7 @@ impl Tunables {
         config.admm = self.admm;
         config.ship = self.ship;
         config.tug = self.tug;
+        config.centralized = self.centralized;
         config.guidance = self.guidance;
         config.inner = self.inner;
         config.tracking = self.tracking;
@@ -200,7 +204,7 @@ pub fn real_parameter_index(vr: u32) -> Option<usize> {
 }
 
 /// The Real parameters, in value-reference order (`10 + index`).
-pub const REAL_PARAMETERS: [RealParameter; 34] = [
+pub const REAL_PARAMETERS: [RealParameter; 37] = [
     RealParameter {
         name: "sample_time",
         unit: "s",
@@ -511,6 +515,33 @@ pub const REAL_PARAMETERS: [RealParameter; 34] = [
         get: |t| t.tracking.give_way_lookahead,
         set: |t, v| t.tracking.give_way_lookahead = v,
     },
+    RealParameter {
+        name: "port_turn_margin",
+        unit: "rad",
+        min: 0.0,
+        exclusive: false,
+        description: "While a head-on or crossing encounter lasts (schemes I, II), the ship's predicted heading stays to starboard of the highest heading reached since it began, less this margin (COLREGS Rules 8(d), 14, 15, 17(c): no turn to port); 2 deg, the course change evaluators count as none (docs/assumptions.md)",
+        get: |t| t.tracking.port_turn_margin,
+        set: |t, v| t.tracking.port_turn_margin = v,
+    },
+    RealParameter {
+        name: "port_turn_weight",
+        unit: "",
+        min: 0.0,
+        exclusive: false,
+        description: "Weight w_P (1/rad^2) of the one-sided heading term w_P min(0, psi - psi_floor)^2 of the ship's cost; not in the paper; 100 (docs/assumptions.md)",
+        get: |t| t.ship.port_turn_weight,
+        set: |t, v| t.ship.port_turn_weight = v,
+    },
+    RealParameter {
+        name: "centralized_thrust_rate_weight",
+        unit: "",
+        min: 0.0,
+        exclusive: false,
+        description: "Centralized MPC only (architecture 2): weight (1/N^2, 1/(N m)^2) of the tugs' thrust changes sum |tau_h - tau_h-1|^2, not in the paper; without it the tugs' thrusts, slaved to the ship's plan by the configuration restriction, alternate from sample to sample and grow; 0.01 (docs/assumptions.md)",
+        get: |t| t.centralized.thrust_rate_weight,
+        set: |t, v| t.centralized.thrust_rate_weight = v,
+    },
 ];
 
 /// Start values of the Integer parameters `hull_model`, `architecture`,
@@ -581,14 +612,7 @@ fn build() -> ModelDescription {
         shared::scenario_parameter(
             "Path of the scenario file (TOML, docs/scenario-format.md) giving the prediction models, formation, route and waterway; empty: the bundled paper scenario resources/paper.toml. Use the plant's scenario.",
         ),
-        parameter(
-            "log_file",
-            LOG_FILE,
-            VariableKind::String {
-                start: Some(String::new()),
-            },
-            "Reserved for the path of the MCAP log: MCAP logging arrives with the logging issue; must be empty for now (a non-empty value is refused at fmi2ExitInitializationMode)",
-        ),
+        shared::log_file_parameter(),
         parameter(
             "hull_model",
             HULL_MODEL,

@@ -149,7 +149,7 @@ fn bad_parameters_are_refused_at_exit_initialization_naming_them() {
         ),
         (
             "log_file",
-            Box::new(|f| f.set_string(var("log_file"), "run.mcap")),
+            Box::new(|f| f.set_string(var("log_file"), "/nonexistent-dir/run.mcap")),
         ),
         (
             "hull_model",

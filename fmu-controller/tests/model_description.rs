@@ -90,6 +90,12 @@ fn parameter_start_values_are_the_rust_defaults() {
         ("lookahead", c.tracking.lookahead),
         ("los_distance", c.tracking.los_distance),
         ("give_way_lookahead", c.tracking.give_way_lookahead),
+        ("port_turn_margin", c.tracking.port_turn_margin),
+        ("port_turn_weight", c.ship.port_turn_weight),
+        (
+            "centralized_thrust_rate_weight",
+            c.centralized.thrust_rate_weight,
+        ),
     ];
     for (name, value) in &expected {
         assert_eq!(start_real(name), *value, "start value of {name}");

@@ -6,6 +6,7 @@
 //! in `fmi2-slave`; this crate denies it.
 #![deny(unsafe_code)]
 
+pub mod logging;
 pub mod plant;
 pub mod variables;
 

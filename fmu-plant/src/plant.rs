@@ -4,11 +4,21 @@
 //! output is valid during initialization, as libcosim reads them there), and read again if a
 //! parameter changes before initialization ends. A bad scenario or parameter is refused with
 //! `fmi2Error` and a message naming the file, the field and the reason.
+//!
+//! MCAP log (docs/logging.md): with `log_file` set, the file is created when initialization
+//! ends (with the state at the start time) and gets every topic after each step; terminate
+//! closes it (a failure is `fmi2Error`), and `fmi2FreeInstance` closes it if terminate did
+//! not. The log is the instance's own: it is not part of the FMU state, and the copies the
+//! layer keeps for FMU states share it.
 
+use crate::logging::{self, LogScenario, StepSnapshot};
 use crate::variables as vars;
 use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use towing_interface::ScenarioFile;
+use towing_log::topics::Log;
+use towing_log::{LogOptions, LogWriter, RunInfo, SharedLog};
 use towing_model::{
     HullModel, Scenario, TowlineModel, World, WorldConfig, WorldInputs, MAX_OBSTACLES,
 };
@@ -22,6 +32,7 @@ const STATE_MAGIC: &[u8; 4] = b"TWPL";
 #[derive(Debug, Clone, PartialEq, Default)]
 struct Parameters {
     scenario: String,
+    log_file: String,
     hull_model: i32,
     towline_model: i32,
     integration_step: f64,
@@ -80,6 +91,8 @@ struct Loaded {
     origin: String,
     text: String,
     world: World,
+    /// What the log needs from the scenario (shared with the log's writer thread).
+    log_info: Arc<LogScenario>,
 }
 
 /// The towing plant: ship, two tugs, two towlines and traffic.
@@ -91,6 +104,10 @@ pub struct Plant {
     /// Set once initialization mode was entered: parameter changes then reload at once.
     initializing: bool,
     loaded: Option<Loaded>,
+    /// `fmi2SetupExperiment`'s start time (s).
+    start_time: f64,
+    /// The MCAP log, open from the end of initialization while `log_file` is set.
+    log: SharedLog,
 }
 
 impl Plant {
@@ -104,6 +121,7 @@ impl Plant {
         } = ScenarioFile::load(&self.params.scenario, self.resource_dir.as_deref())?;
         let world = World::new(&scenario, self.params.world_config(&scenario))
             .map_err(|e| format!("{origin}: {e}"))?;
+        let log_info = Arc::new(LogScenario::of(&scenario));
         log.info(
             "logEvents",
             &format!(
@@ -116,6 +134,7 @@ impl Plant {
             origin,
             text,
             world,
+            log_info,
         });
         Ok(())
     }
@@ -131,6 +150,78 @@ impl Plant {
     fn world(&self) -> Option<&World> {
         self.loaded.as_ref().map(|l| &l.world)
     }
+
+    /// Creates the log named by `log_file` (if any) and writes the run description, the
+    /// static scene and the state at the start time.
+    fn open_log(&mut self, log: &Logger) -> Result<(), String> {
+        // A log of an earlier initialization (after fmi2Reset) is closed by `release`.
+        if self.params.log_file.is_empty() {
+            return Ok(());
+        }
+        let Some(loaded) = self.loaded.as_ref() else {
+            return Ok(());
+        };
+        let mut writer = LogWriter::create(&self.params.log_file, LogOptions::default())
+            .map_err(|e| format!("parameter `log_file`: {e}"))?;
+        let t = self.start_time;
+        let guid = vars::DESCRIPTION.guid();
+        let p = &self.params;
+        let parameters = serde_json::json!({
+            "scenario": p.scenario,
+            "log_file": p.log_file,
+            "hull_model": p.hull_model,
+            "towline_model": p.towline_model,
+            "integration_step": p.integration_step,
+        });
+        let info = RunInfo {
+            unit: vars::MODEL_IDENTIFIER,
+            guid: &guid,
+            version: env!("CARGO_PKG_VERSION"),
+            scenario: &p.scenario,
+            scenario_name: &loaded.log_info.name,
+            start_time: t,
+            parameters,
+            scenario_text: &loaded.text,
+        };
+        let written = writer
+            .write_run(&info)
+            .and_then(|()| logging::register_topics(&mut writer))
+            .and_then(|()| {
+                logging::write_static_scene(&mut writer, t, &loaded.world, &loaded.log_info)
+            })
+            .and_then(|()| {
+                let snap = StepSnapshot::capture(t, &loaded.world, &self.inputs);
+                logging::write_state(&mut writer, &snap, &loaded.log_info)
+            });
+        if let Err(e) = written {
+            let _ = writer.finish();
+            return Err(format!("parameter `log_file`: {e}"));
+        }
+        // From here on the messages are serialized and written on the log's own thread.
+        self.log = SharedLog::spawn(writer).map_err(|e| format!("parameter `log_file`: {e}"))?;
+        log.info(
+            "logEvents",
+            &format!("MCAP log {} created", self.params.log_file),
+        );
+        Ok(())
+    }
+
+    /// Writes the state at `t` after a step; a logging failure becomes a warning.
+    fn log_step(&self, t: f64) -> Option<String> {
+        let loaded = self.loaded.as_ref()?;
+        let snap = StepSnapshot::capture(t, &loaded.world, &self.inputs);
+        let info = Arc::clone(&loaded.log_info);
+        self.log
+            .batch(Box::new(move |w| logging::write_state(w, &snap, &info)))
+    }
+
+    /// Writes a warning or error the plant reports to `/plant/log`.
+    fn log_line(&self, t: f64, level: i32, message: &str) -> Option<String> {
+        let message = message.to_owned();
+        self.log.batch(Box::new(move |w| {
+            logging::write_log_line(w, t, level, &message)
+        }))
+    }
 }
 
 impl Fmi2Model for Plant {
@@ -145,7 +236,20 @@ impl Fmi2Model for Plant {
             resource_dir: ctx.resource_dir.map(Path::to_path_buf),
             initializing: false,
             loaded: None,
+            start_time: 0.0,
+            log: SharedLog::none(),
         })
+    }
+
+    fn setup_experiment(
+        &mut self,
+        _log: &Logger,
+        start_time: f64,
+        _stop_time: Option<f64>,
+        _tolerance: Option<f64>,
+    ) -> Result<(), String> {
+        self.start_time = start_time;
+        Ok(())
     }
 
     fn enter_initialization_mode(&mut self, log: &Logger) -> Result<(), String> {
@@ -153,10 +257,10 @@ impl Fmi2Model for Plant {
         self.load(log)
     }
 
-    fn exit_initialization_mode(&mut self, _log: &Logger) -> Result<(), String> {
+    fn exit_initialization_mode(&mut self, log: &Logger) -> Result<(), String> {
         self.initializing = false;
         match self.loaded {
-            Some(_) => Ok(()),
+            Some(_) => self.open_log(log),
             None => Err("no scenario is loaded".to_owned()),
         }
     }
@@ -262,6 +366,7 @@ impl Fmi2Model for Plant {
     fn get_string(&self, vr: u32) -> String {
         match vr {
             vars::SCENARIO => self.params.scenario.clone(),
+            vars::LOG_FILE => self.params.log_file.clone(),
             _ => String::new(),
         }
     }
@@ -276,6 +381,10 @@ impl Fmi2Model for Plant {
                 }
                 Ok(())
             }
+            vars::LOG_FILE => {
+                value.clone_into(&mut self.params.log_file);
+                Ok(())
+            }
             _ => Err(format!("value reference {vr} is not a settable String")),
         }
     }
@@ -284,7 +393,7 @@ impl Fmi2Model for Plant {
         let Some(loaded) = self.loaded.as_mut() else {
             return StepOutcome::Error("no scenario is loaded".to_owned());
         };
-        match loaded.world.step(&self.inputs, step.step_size) {
+        let outcome = match loaded.world.step(&self.inputs, step.step_size) {
             Ok(()) => StepOutcome::Ok,
             Err(e) => StepOutcome::Discard(format!(
                 "step from t = {} s by h = {} s refused: {e}; the state is left at t = {} s",
@@ -292,11 +401,38 @@ impl Fmi2Model for Plant {
                 step.step_size,
                 loaded.world.time()
             )),
+        };
+        if !self.log.is_active() {
+            return outcome;
+        }
+        let failed = match &outcome {
+            StepOutcome::Ok | StepOutcome::Warning(_) => {
+                self.log_step(step.current_time + step.step_size)
+            }
+            StepOutcome::Discard(m) | StepOutcome::Error(m) => {
+                self.log_line(step.current_time, Log::ERROR, m)
+            }
+        };
+        match (failed, outcome) {
+            (Some(warning), StepOutcome::Ok) => StepOutcome::Warning(warning),
+            (Some(warning), StepOutcome::Warning(m)) => {
+                StepOutcome::Warning(format!("{m}; {warning}"))
+            }
+            (_, outcome) => outcome,
         }
     }
 
     fn terminate(&mut self, _log: &Logger) -> Result<(), String> {
-        Ok(())
+        self.log
+            .finish()
+            .map(drop)
+            .map_err(|e| format!("closing the log: {e}"))
+    }
+
+    fn release(&mut self, log: &Logger) {
+        if let Err(e) = self.log.finish() {
+            log.error(&format!("closing the log: {e}"));
+        }
     }
 
     fn serialize_state(&self, out: &mut Vec<u8>) {
@@ -341,6 +477,7 @@ impl Fmi2Model for Plant {
         }
         let params = Parameters {
             scenario: r.string()?,
+            log_file: String::new(),
             hull_model: i32::from_le_bytes(r.array()?),
             towline_model: i32::from_le_bytes(r.array()?),
             integration_step: f64::from_le_bytes(r.array()?),
@@ -356,11 +493,17 @@ impl Fmi2Model for Plant {
         }
         let initializing = r.take(1)?[0] != 0;
         let mut restored = Self {
-            params,
+            params: Parameters {
+                // The log is the instance's own, not part of the state.
+                log_file: self.params.log_file.clone(),
+                ..params
+            },
             inputs,
             resource_dir: self.resource_dir.clone(),
             initializing,
             loaded: None,
+            start_time: self.start_time,
+            log: self.log.clone(),
         };
         if r.take(1)?[0] == 1 {
             let origin = r.string()?;
@@ -375,10 +518,12 @@ impl Fmi2Model for Plant {
             let config = restored.params.world_config(&scenario);
             let mut world = World::new(&scenario, config).map_err(|e| format!("{origin}: {e}"))?;
             world.read_state(world_bytes)?;
+            let log_info = Arc::new(LogScenario::of(&scenario));
             restored.loaded = Some(Loaded {
                 origin,
                 text,
                 world,
+                log_info,
             });
         }
         if r.pos != bytes.len() {

@@ -6,8 +6,9 @@
 //!
 //! The connected variables (vessel states, towline values and obstacle slots as outputs, the
 //! commands as inputs) and their value references, units and declared types are those of
-//! the interface contract, `towing-interface`; this module adds the plant's parameters
-//! (value references 1..=9) and the Boolean outputs `towlineN.slack` (`vr::towline(line, 3)`).
+//! the interface contract, `towing-interface` (with the String parameters `scenario` and
+//! `log_file`); this module adds the plant's own parameters (value references 2..=9) and
+//! the Boolean outputs `towlineN.slack` (`vr::towline(line, 3)`).
 
 use fmi2_slave::description::{ModelDescription, VariableKind};
 use std::sync::LazyLock;
@@ -17,7 +18,7 @@ use towing_interface::ModelInfo;
 use towing_model::WorldConfig;
 
 pub use towing_interface::vr::{
-    obstacle, tension_cmd, towline, tug_force, vessel_state, OBSTACLE_KIND, SCENARIO,
+    obstacle, tension_cmd, towline, tug_force, vessel_state, LOG_FILE, OBSTACLE_KIND, SCENARIO,
 };
 
 /// `hull_model` (Integer parameter): 1 linear damping, 2 nonlinear damping.
@@ -61,6 +62,7 @@ fn build() -> ModelDescription {
         shared::scenario_parameter(
             "Path of the scenario file (TOML, docs/scenario-format.md); empty: the bundled paper scenario resources/paper.toml",
         ),
+        shared::log_file_parameter(),
         parameter(
             "hull_model",
             HULL_MODEL,

@@ -495,9 +495,9 @@ fn instantiate_checked<M: Fmi2Model>(
     }))
 }
 
-/// `fmi2FreeInstance`: NULL or a foreign pointer is ignored; otherwise the instance and
-/// everything it owns is dropped (a panic in the model's destructor is logged, not
-/// propagated).
+/// `fmi2FreeInstance`: NULL or a foreign pointer is ignored; otherwise
+/// [`Fmi2Model::release`] runs and the instance and everything it owns is dropped (a panic
+/// in either is logged, not propagated).
 pub unsafe fn free_instance<M: Fmi2Model>(c: Fmi2Component) {
     // SAFETY: forwarded contract.
     let Some(inst) = (unsafe { instance_mut::<M>(c) }) else {
@@ -510,7 +510,18 @@ pub unsafe fn free_instance<M: Fmi2Model>(c: Fmi2Component) {
     // SAFETY: `c` came from `Box::into_raw` in `fmi2Instantiate` (tag checked) and is
     // freed exactly once (the tag is now dead).
     let boxed = unsafe { Box::from_raw(c.cast::<Instance<M>>()) };
-    let Instance { model, logger, .. } = *boxed;
+    let Instance {
+        mut model, logger, ..
+    } = *boxed;
+    if let Err(payload) = catch_unwind(AssertUnwindSafe(|| model.release(&logger))) {
+        let text = panic_text(payload.as_ref());
+        drop_payload(payload);
+        logger.log(
+            Fmi2Status::Fatal,
+            status_category(Fmi2Status::Fatal),
+            &format!("fmi2FreeInstance: panic while releasing the model: {text}"),
+        );
+    }
     if let Err(payload) = catch_unwind(AssertUnwindSafe(move || drop(model))) {
         let text = panic_text(payload.as_ref());
         drop_payload(payload);
@@ -631,7 +642,8 @@ pub unsafe fn terminate<M: Fmi2Model>(c: Fmi2Component) -> Fmi2Status {
 }
 
 /// `fmi2Reset` (FMI 2.0 section 2.1.6): re-runs `Fmi2Model::instantiate` with the stored
-/// context and returns to `instantiated`; logger and debug-logging settings are kept.
+/// context (after [`Fmi2Model::release`] on the old model) and returns to `instantiated`;
+/// logger and debug-logging settings are kept.
 pub unsafe fn reset<M: Fmi2Model>(c: Fmi2Component) -> Fmi2Status {
     // SAFETY: forwarded FMI contract.
     unsafe {
@@ -644,6 +656,7 @@ pub unsafe fn reset<M: Fmi2Model>(c: Fmi2Component) -> Fmi2Status {
                 };
                 M::instantiate(&ctx)?
             };
+            inst.model.release(&inst.logger);
             inst.model = model;
             inst.layer = LayerState::new();
             inst.strings.clear();

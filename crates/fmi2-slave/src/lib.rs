@@ -181,6 +181,12 @@ pub trait Fmi2Model: Clone + Send + Sized + 'static {
     /// `fmi2Terminate`: flush logs, close files.
     fn terminate(&mut self, log: &Logger) -> Result<(), String>;
 
+    /// Called by `fmi2FreeInstance` and `fmi2Reset` just before the model is dropped,
+    /// whether or not `fmi2Terminate` ran: close what [`terminate`](Self::terminate) did
+    /// not (a log file, say) and report problems through `log`, since neither function can
+    /// return them to the master. A panic here is caught and logged. Default: nothing.
+    fn release(&mut self, _log: &Logger) {}
+
     /// Append the model's state as pointer-free bytes with the model's own versioning
     /// (`fmi2SerializeFMUstate`).
     fn serialize_state(&self, out: &mut Vec<u8>);

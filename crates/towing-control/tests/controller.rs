@@ -285,7 +285,9 @@ fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
         kind: 2,
     };
     m.obstacles[3] = target;
-    let margin = ControllerConfig::new(scenario.clone()).tracking.port_turn_margin;
+    let margin = ControllerConfig::new(scenario.clone())
+        .tracking
+        .port_turn_margin;
     let controller = |scheme| {
         let mut config = ControllerConfig::new(scenario.clone());
         config.scheme = scheme;
@@ -298,7 +300,7 @@ fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
     assert!((floor - (psi - margin)).abs() < 1e-12, "{floor} vs {psi}");
 
     // The ship has turned 10 deg to starboard: the floor follows.
-    let mut turned = m.clone();
+    let mut turned = m;
     turned.ship[2] = psi + 10f64.to_radians();
     let r = c.sample(&turned).unwrap();
     let up = r.heading_floor.unwrap();
@@ -308,7 +310,7 @@ fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
     assert!((r.heading_floor.unwrap() - up).abs() < 1e-12);
 
     // The target gone: no floor.
-    let mut clear = m.clone();
+    let mut clear = m;
     clear.obstacles[3].kind = 0;
     assert_eq!(c.sample(&clear).unwrap().heading_floor, None);
 

@@ -3,8 +3,8 @@
 //! its name, value reference, unit, declared type and description, for both ends of the
 //! connection.
 //!
-//! * [`vr`]: the value references of the connected variables and of `scenario`, equal in
-//!   both FMUs.
+//! * [`vr`]: the value references of the connected variables and of `scenario` and
+//!   `log_file`, equal in both FMUs.
 //! * [`variables`]: builders of those variables for one end of the connection
 //!   ([`Direction::Output`] in the FMU that computes them, [`Direction::Input`] in the one
 //!   that reads them), and the generic parameter/input/output builders.
@@ -58,7 +58,7 @@ pub const COMMANDS: [u32; 8] = [
 ];
 
 /// The names of DESIGN.md's interface contract every FMU declares: the commands, the vessel
-/// states, the towline values, the obstacle slots and `scenario`.
+/// states, the towline values, the obstacle slots, `scenario` and `log_file`.
 #[must_use]
 pub fn contract_names() -> Vec<String> {
     let mut names = vec![];
@@ -83,6 +83,7 @@ pub fn contract_names() -> Vec<String> {
         }
     }
     names.push("scenario".into());
+    names.push("log_file".into());
     names
 }
 

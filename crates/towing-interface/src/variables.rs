@@ -183,6 +183,20 @@ pub fn scenario_parameter(description: &str) -> Variable {
     )
 }
 
+/// The String parameter `log_file` ([`vr::LOG_FILE`], start empty): the MCAP log of the
+/// unit (docs/logging.md), created when initialization ends; empty, no log.
+#[must_use]
+pub fn log_file_parameter() -> Variable {
+    parameter(
+        "log_file",
+        vr::LOG_FILE,
+        VariableKind::String {
+            start: Some(String::new()),
+        },
+        "Path of the MCAP log of this unit (docs/logging.md), created (replaced) at fmi2ExitInitializationMode and closed at fmi2Terminate; empty: no log",
+    )
+}
+
 /// An input (its start value is in `kind`).
 #[must_use]
 pub fn input(name: String, vr: u32, kind: VariableKind, description: String) -> Variable {
@@ -437,7 +451,7 @@ mod tests {
     }
 
     #[test]
-    fn every_contract_name_but_scenario_has_a_builder() {
+    fn every_contract_name_has_a_builder() {
         let mut all = Vec::new();
         for d in [Direction::Output, Direction::Input] {
             all.extend(commands(d));
@@ -446,10 +460,10 @@ mod tests {
             all.extend(towline(1, d));
             all.extend(obstacles(d));
         }
+        all.push(scenario_parameter("scenario"));
+        all.push(log_file_parameter());
         for name in crate::contract_names() {
-            if name != "scenario" {
-                assert!(all.iter().any(|v| v.name == name), "{name}");
-            }
+            assert!(all.iter().any(|v| v.name == name), "{name}");
         }
     }
 }

@@ -1,6 +1,6 @@
 //! The benchmark set-up shared by `benches/do_step.rs` and `examples/do_step_latency.rs`:
-//! a plant instance on a scenario whose 8 obstacles are all active, seeded inputs, and one
-//! master-style communication step.
+//! a plant instance on a scenario whose 8 obstacles are all active (optionally writing an
+//! MCAP log), seeded inputs, and one master-style communication step.
 #![allow(dead_code, clippy::unwrap_used, clippy::expect_used)]
 
 use fmi2_slave::ffi::Fmi2Status;
@@ -23,6 +23,11 @@ pub struct Bench {
 
 impl Bench {
     pub fn new() -> Bench {
+        Self::with_log(None)
+    }
+
+    /// As [`Bench::new`], with `log_file` set to `log` when given.
+    pub fn with_log(log: Option<&std::path::Path>) -> Bench {
         let scenario = towing_interface::testing::workspace_root().join(EIGHT_OBSTACLES);
         let fmu = Fmu::try_new(
             fmi2_slave::exports_of!(towing_plant),
@@ -37,6 +42,12 @@ impl Bench {
             Fmi2Status::Ok
         );
         assert_eq!(fmu.set_integer(vars::HULL_MODEL, 2), Fmi2Status::Ok);
+        if let Some(log) = log {
+            assert_eq!(
+                fmu.set_string(vars::LOG_FILE, log.to_str().unwrap()),
+                Fmi2Status::Ok
+            );
+        }
         fmu.init(0.0, None);
         for slot in 0..8 {
             assert_ne!(

@@ -1,0 +1,770 @@
+//! COLREGS assessment of one target-ship encounter after the run: detection, first
+//! action, course change, closest point of approach (CPA), side of the pass, a verdict from
+//! binary rule checks, and the rule scores of Woerner et al. (2018) as summarised in
+//! `reference/colregs.md`, with range parameters at model scale.
+//!
+//! Angles: bearings in `(-180, 180]` deg, positive to starboard (NED, clockwise).
+//! `beta` is the bearing of the target from own bow, `alpha` the bearing of own ship from
+//! the target's bow (contact angle). Own ship is the towed ship (the tow's COLREGS
+//! identity, `docs/colregs.md`); its course is its heading.
+
+use serde::Serialize;
+
+use crate::geometry::{relative_bearing, wrap};
+
+/// Range and scoring parameters. The published values are full scale (e.g. `r_min`
+/// 100 m, `r_nm` 50 m, `r_col` 30 m); [`ScoringParams::model_scale`] derives them from
+/// the vessels' sizes with the same ratios, see `docs/analyzer.md`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ScoringParams {
+    /// Detection range `r_detect`, m: the controller's detection distance `d_D`.
+    pub r_detect_m: f64,
+    /// Range above which the pass is fully safe, `r_min`, m.
+    pub r_min_m: f64,
+    /// Near-miss range `r_nm`, m.
+    pub r_nm_m: f64,
+    /// Collision range `r_col`, m.
+    pub r_col_m: f64,
+    /// The same four ranges in own-ship lengths (detect, min, near miss, collision).
+    pub ranges_in_ship_lengths: [f64; 4],
+    /// Own (towed) ship length, m.
+    pub ship_length_m: f64,
+    /// Loss of the range score across `[r_nm, r_min]`.
+    pub gamma_nm: f64,
+    /// Loss of the range score across `[r_col, r_nm]` (`gamma_nm + gamma_col = 1`: the
+    /// score reaches 0 at `r_col`).
+    pub gamma_col: f64,
+    /// Weight of the range part of the safety score.
+    pub w_r: f64,
+    /// Weight of the pose part (`w_r + w_theta = 1`).
+    pub w_theta: f64,
+    /// Course change that is "readily apparent" (Rule 8), deg.
+    pub dchi_apparent_deg: f64,
+    /// Starboard turn that fully satisfies Rule 14, deg.
+    pub dchi_starboard_deg: f64,
+    /// Heading change after detection that counts as the first action, deg.
+    pub action_threshold_deg: f64,
+    /// Heading change to port that counts as a port turn in the verdict, deg.
+    pub port_turn_deg: f64,
+}
+
+impl ScoringParams {
+    /// Model-scale parameters for own ship length `ship_length`, a target of length
+    /// `target_length`, detection distance `d_detect` and buffer `d_s0`:
+    /// `r_col = (L + L_target) / 2` (the centres' range at bow-to-bow contact),
+    /// `r_nm = L + L_target / 2 + d_S0` (the guidance's safe range for a ship,
+    /// `docs/colregs.md` section 1), `r_min = 2 r_nm` (Woerner's `r_min / r_nm` =
+    /// 100 / 50), `r_detect = d_D`.
+    #[must_use]
+    pub fn model_scale(ship_length: f64, target_length: f64, d_detect: f64, d_s0: f64) -> Self {
+        let r_col = (ship_length + target_length) / 2.0;
+        let r_nm = ship_length + target_length / 2.0 + d_s0;
+        let r_min = 2.0 * r_nm;
+        ScoringParams {
+            r_detect_m: d_detect,
+            r_min_m: r_min,
+            r_nm_m: r_nm,
+            r_col_m: r_col,
+            ranges_in_ship_lengths: [
+                d_detect / ship_length,
+                r_min / ship_length,
+                r_nm / ship_length,
+                r_col / ship_length,
+            ],
+            ship_length_m: ship_length,
+            gamma_nm: 0.4,
+            gamma_col: 0.6,
+            w_r: 0.8,
+            w_theta: 0.2,
+            dchi_apparent_deg: 30.0,
+            dchi_starboard_deg: 20.0,
+            action_threshold_deg: 5.0,
+            port_turn_deg: 10.0,
+        }
+    }
+}
+
+/// One sample of an encounter: own ship and target at the same time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EncounterSample {
+    /// Time, s.
+    pub t: f64,
+    /// Own ship North, East (m), heading (rad), speed over ground (m/s).
+    pub own: [f64; 4],
+    /// Target North, East (m), course (rad), speed (m/s).
+    pub target: [f64; 4],
+    /// The controller's reference was altered at this time (`None`: no controller log).
+    pub altered: Option<bool>,
+    /// Smallest centre range from any vessel of the tow (ship, tugs) to the target, m:
+    /// the tow detects a target by its nearest vessel (eq. (8)), which can be a tug well
+    /// before the ship.
+    pub tow_range: f64,
+}
+
+/// The COLREGS situation (codes as the controller FMU's `colregs[k].situation`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Situation {
+    /// Not closing.
+    Safe,
+    /// Rule 14.
+    HeadOn,
+    /// Rule 15/16, target on own starboard side.
+    CrossingGiveWay,
+    /// Rule 15/17, target on own port side.
+    CrossingStandOn,
+    /// Rule 13, own ship overtaking.
+    Overtaking,
+    /// Rule 13/17, own ship being overtaken.
+    BeingOvertaken,
+    /// Closing, no sector.
+    Unclassified,
+}
+
+impl Situation {
+    /// From the controller's code (-1 none and unknown codes: `None`).
+    #[must_use]
+    pub fn from_code(code: i32) -> Option<Self> {
+        Some(match code {
+            0 => Situation::Safe,
+            1 => Situation::HeadOn,
+            2 => Situation::CrossingGiveWay,
+            3 => Situation::CrossingStandOn,
+            4 => Situation::Overtaking,
+            5 => Situation::BeingOvertaken,
+            6 => Situation::Unclassified,
+            _ => return None,
+        })
+    }
+
+    /// Text as in the controller log.
+    #[must_use]
+    pub fn label(self) -> &'static str {
+        match self {
+            Situation::Safe => "safe",
+            Situation::HeadOn => "head-on",
+            Situation::CrossingGiveWay => "crossing give-way",
+            Situation::CrossingStandOn => "crossing stand-on",
+            Situation::Overtaking => "overtaking",
+            Situation::BeingOvertaken => "being overtaken",
+            Situation::Unclassified => "unclassified",
+        }
+    }
+
+    /// True for a situation a rule applies to (not safe).
+    #[must_use]
+    pub fn definite(self) -> bool {
+        !matches!(self, Situation::Safe)
+    }
+}
+
+/// Woerner-style classification (`docs/colregs.md` section 3, default preset) from the
+/// bearing `beta`, contact angle `alpha` (deg) and the speeds.
+#[must_use]
+pub fn classify(beta_deg: f64, alpha_deg: f64, own_speed: f64, target_speed: f64) -> Situation {
+    if beta_deg.abs() <= 13.0 && alpha_deg.abs() <= 13.0 {
+        Situation::HeadOn
+    } else if alpha_deg.abs() > 112.5 && beta_deg.abs() <= 45.0 && own_speed > target_speed {
+        Situation::Overtaking
+    } else if beta_deg.abs() > 112.5 && alpha_deg.abs() <= 45.0 && target_speed > own_speed {
+        Situation::BeingOvertaken
+    } else if (0.0..=112.5).contains(&beta_deg) && (-112.5..=-10.0).contains(&alpha_deg) {
+        Situation::CrossingGiveWay
+    } else if (-112.5..=0.0).contains(&beta_deg) && (10.0..=112.5).contains(&alpha_deg) {
+        Situation::CrossingStandOn
+    } else {
+        Situation::Unclassified
+    }
+}
+
+/// The rule scores (each in `[0, 1]`, 1 best) and their parts.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Scores {
+    /// Range part `s_r` at the CPA.
+    pub s_range: f64,
+    /// Pose part `s_theta = (1 - cos alpha)(1 - cos beta)` at the CPA (angles clipped at
+    /// 90 deg).
+    pub s_pose: f64,
+    /// `S_safety = w_r s_r + w_theta s_theta`.
+    pub safety: f64,
+    /// Delay penalty `P_delay`.
+    pub p_delay: f64,
+    /// Not-readily-apparent penalty `P_na` (Rule 8).
+    pub p_not_apparent: f64,
+    /// Rule 14: no-starboard-turn penalty `P_nsb`.
+    pub p_no_starboard: f64,
+    /// Rule 14: starboard-to-starboard penalty `P_sts`.
+    pub p_starboard_to_starboard: f64,
+    /// Rule 15: passed ahead of the target (`-25 < alpha_cpa < 165` deg).
+    pub p_ahead_rule15: f64,
+    /// Rule 13: ended ahead of the target (`|alpha_cpa| < 45` deg).
+    pub p_ahead_rule13: f64,
+    /// Rule 17: course-change penalty `P_dchi`.
+    pub p_course_change: f64,
+    /// Rule 17: speed-change penalty (relative speed change, see `docs/analyzer.md`).
+    pub p_speed_change: f64,
+    /// Rule 16 (give-way action).
+    pub rule16: f64,
+    /// Rule 14 (head-on).
+    pub rule14: f64,
+    /// Rule 15 (crossing, give-way: do not pass ahead).
+    pub rule15: f64,
+    /// Rule 13 (overtaking).
+    pub rule13: f64,
+    /// Rule 17 (stand-on).
+    pub rule17: f64,
+}
+
+/// Everything reported for one target-ship encounter.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EncounterReport {
+    /// Target name (scenario).
+    pub target: String,
+    /// Obstacle slot.
+    pub slot: u32,
+    /// Situation held by the controller (first definite one it reported), if logged.
+    pub situation: Option<String>,
+    /// The tow's role from the controller (`give-way`, `stand-on`), if logged.
+    pub role: Option<String>,
+    /// Every distinct situation the controller reported, in order.
+    pub situations_reported: Vec<String>,
+    /// This analyzer's classification from the geometry at detection.
+    pub situation_geometric: Option<String>,
+    /// The situation the verdict and the rule score use (the controller's, else the
+    /// geometric one).
+    pub situation_assessed: Option<String>,
+    /// First time the range (centre to centre) is below `r_detect`, s.
+    pub t_detect_s: Option<f64>,
+    /// First time any vessel of the tow is within `r_detect` (the guidance's detection);
+    /// the first action and the course change are looked for from here.
+    pub t_detect_tow_s: Option<f64>,
+    /// Time of the tow's first action after detection (the reference becoming altered,
+    /// or the heading changing by the action threshold), s.
+    pub t_first_action_s: Option<f64>,
+    /// What the first action was.
+    pub first_action: Option<String>,
+    /// Range at the first action, m.
+    pub r_first_action_m: Option<f64>,
+    /// Largest heading change between detection and CPA (+ starboard, - port), deg.
+    pub course_change_deg: Option<f64>,
+    /// Largest heading change to starboard, deg.
+    pub course_change_starboard_deg: Option<f64>,
+    /// Largest heading change to port, deg.
+    pub course_change_port_deg: Option<f64>,
+    /// Time of the CPA (smallest range), s.
+    pub t_cpa_s: f64,
+    /// Range at the CPA, m.
+    pub r_cpa_m: f64,
+    /// Range at the CPA in own-ship lengths.
+    pub r_cpa_ship_lengths: f64,
+    /// Bearing of the target from own bow at the CPA, deg (+ starboard).
+    pub beta_cpa_deg: f64,
+    /// Bearing of own ship from the target's bow at the CPA, deg (+ starboard).
+    pub alpha_cpa_deg: f64,
+    /// Side of own ship the target passed on (`port` / `starboard`, sign of `beta_cpa`).
+    pub side: String,
+    /// `ahead` or `astern` of the target (Rule 15's test on `alpha_cpa`).
+    pub passed: String,
+    /// The CPA is the last sample of the target's track (the log may end before the
+    /// encounter does).
+    pub cpa_at_end_of_log: bool,
+    /// `compliant`, `violation`, or `no encounter` (never within `r_detect`).
+    pub verdict: String,
+    /// Why it is a violation.
+    pub reasons: Vec<String>,
+    /// The rule the score is for (`13`, `14`, `15`, `16`, `17`), if any.
+    pub rule: Option<u8>,
+    /// That rule's score.
+    pub score: Option<f64>,
+    /// Every score and its parts.
+    pub scores: Option<Scores>,
+    /// The parameters used.
+    pub params: ScoringParams,
+}
+
+/// Range score `s_r`: 1 at or above `r_min`, falling linearly by `gamma_nm` down to
+/// `r_nm` and by `gamma_col` down to `r_col`, 0 below.
+#[must_use]
+pub fn range_score(r: f64, p: &ScoringParams) -> f64 {
+    let s = if r >= p.r_min_m {
+        1.0
+    } else if r >= p.r_nm_m {
+        1.0 - p.gamma_nm * (p.r_min_m - r) / (p.r_min_m - p.r_nm_m)
+    } else if r >= p.r_col_m {
+        1.0 - p.gamma_nm - p.gamma_col * (p.r_nm_m - r) / (p.r_nm_m - p.r_col_m)
+    } else {
+        0.0
+    };
+    s.clamp(0.0, 1.0)
+}
+
+/// Scores from the encounter's key quantities (angles in deg).
+#[allow(clippy::too_many_arguments)]
+#[must_use]
+pub fn scores(
+    r_cpa: f64,
+    alpha_cpa_deg: f64,
+    beta_cpa_deg: f64,
+    r_manoeuvre: f64,
+    dchi_starboard_deg: f64,
+    dchi_port_deg: f64,
+    speed_change_rel: f64,
+    p: &ScoringParams,
+) -> Scores {
+    let clip = |v: f64| v.clamp(0.0, 1.0);
+    let s_range = range_score(r_cpa, p);
+    let a90 = alpha_cpa_deg.abs().min(90.0).to_radians();
+    let b90 = beta_cpa_deg.abs().min(90.0).to_radians();
+    let s_pose = (1.0 - a90.cos()) * (1.0 - b90.cos());
+    let safety = p.w_r * s_range + p.w_theta * s_pose;
+    let p_delay = if p.r_detect_m > r_cpa {
+        clip((p.r_detect_m - r_manoeuvre) / (p.r_detect_m - r_cpa))
+    } else {
+        0.0
+    };
+    let dchi_abs = dchi_starboard_deg.max(dchi_port_deg);
+    let p_na = 0.5 * (1.0 - (dchi_abs / p.dchi_apparent_deg).powi(2)).max(0.0);
+    let rule16 = safety * (1.0 - p_delay) * (1.0 - p_na);
+    // Rule 14. colregs.md prints P_nsb = (dchi / 20)^4 below 20 deg and 0 above, which
+    // jumps from 1 to 0 at 20 deg and penalises small turns least; read as its
+    // complement, continuous and falling from 1 (no starboard turn) to 0 (20 deg).
+    let p_nsb = if dchi_port_deg > dchi_starboard_deg {
+        1.0
+    } else if dchi_starboard_deg >= p.dchi_starboard_deg {
+        0.0
+    } else {
+        1.0 - (dchi_starboard_deg / p.dchi_starboard_deg).powi(4)
+    };
+    // P_sts with bearings positive to starboard: a port-to-port pass (alpha = beta =
+    // -90 deg) gives 0, starboard-to-starboard (+90, +90) gives 1. colregs.md's
+    // `(sin + 1) / 2` assumes bearings positive to port.
+    let sa = (1.0 - alpha_cpa_deg.to_radians().sin()) / 2.0;
+    let sb = (1.0 - beta_cpa_deg.to_radians().sin()) / 2.0;
+    let p_sts = 1.0 - (sa * sa) * (sb * sb);
+    let rule14 = clip(1.0 - 0.6 * p_nsb - 0.2 * p_delay - p_sts) * (1.0 - p_na);
+    let p_ahead15 = if alpha_cpa_deg > -25.0 && alpha_cpa_deg < 165.0 {
+        1.0
+    } else {
+        0.0
+    };
+    let rule15 = clip(rule16 - 0.5 * p_ahead15);
+    let p_ahead13 = if alpha_cpa_deg.abs() < 45.0 { 1.0 } else { 0.0 };
+    let rule13 = clip(rule16 - 0.3 * p_ahead13);
+    let p_dchi = 0.5 * clip((dchi_abs - 2.0) / (30.0 - 2.0));
+    let p_du = 0.5 * clip((speed_change_rel.abs() - 0.1) / (0.5 - 0.1));
+    let rule17 = clip((safety - p_dchi) * (1.0 - p_du));
+    Scores {
+        s_range,
+        s_pose,
+        safety,
+        p_delay,
+        p_not_apparent: p_na,
+        p_no_starboard: p_nsb,
+        p_starboard_to_starboard: p_sts,
+        p_ahead_rule15: p_ahead15,
+        p_ahead_rule13: p_ahead13,
+        p_course_change: p_dchi,
+        p_speed_change: p_du,
+        rule16,
+        rule14,
+        rule15,
+        rule13,
+        rule17,
+    }
+}
+
+/// The controller's view of the encounter.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ControllerView {
+    /// Situation codes the controller reported for the slot, in time order.
+    pub situation_codes: Vec<i32>,
+    /// Role texts, parallel to `situation_codes`.
+    pub roles: Vec<String>,
+}
+
+/// Assesses one encounter from its samples (time order; at least one).
+#[must_use]
+pub fn assess(
+    target: &str,
+    slot: u32,
+    samples: &[EncounterSample],
+    controller: Option<&ControllerView>,
+    p: &ScoringParams,
+) -> Option<EncounterReport> {
+    samples.first()?;
+    let range = |s: &EncounterSample| (s.target[0] - s.own[0]).hypot(s.target[1] - s.own[1]);
+    let (i_cpa, r_cpa) = samples
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (i, range(s)))
+        .filter(|(_, r)| r.is_finite())
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    let cpa = samples[i_cpa];
+    let own_p = [cpa.own[0], cpa.own[1]];
+    let tgt_p = [cpa.target[0], cpa.target[1]];
+    let beta_cpa = relative_bearing(own_p, cpa.own[2], tgt_p).to_degrees();
+    let alpha_cpa = relative_bearing(tgt_p, cpa.target[2], own_p).to_degrees();
+
+    // Controller's situation: the first definite one (the held situation), every distinct
+    // one in order, and the role that came with the first definite one.
+    let (mut situation, mut role, mut reported) = (None, None, Vec::<String>::new());
+    if let Some(c) = controller {
+        for (k, &code) in c.situation_codes.iter().enumerate() {
+            if let Some(s) = Situation::from_code(code) {
+                if reported.last().map(String::as_str) != Some(s.label()) {
+                    reported.push(s.label().to_owned());
+                }
+                if situation.is_none() && s.definite() {
+                    situation = Some(s);
+                    role = c.roles.get(k).cloned();
+                }
+            }
+        }
+    }
+
+    let i_det = samples[..=i_cpa]
+        .iter()
+        .position(|s| range(s) < p.r_detect_m);
+    let geometric = i_det.map(|i| {
+        let s = samples[i];
+        let beta = relative_bearing([s.own[0], s.own[1]], s.own[2], [s.target[0], s.target[1]]);
+        let alpha = relative_bearing(
+            [s.target[0], s.target[1]],
+            s.target[2],
+            [s.own[0], s.own[1]],
+        );
+        classify(beta.to_degrees(), alpha.to_degrees(), s.own[3], s.target[3])
+    });
+    let assessed = situation.or(geometric);
+
+    let mut report = EncounterReport {
+        target: target.to_owned(),
+        slot,
+        situation: situation.map(|s| s.label().to_owned()),
+        role,
+        situations_reported: reported,
+        situation_geometric: geometric.map(|s| s.label().to_owned()),
+        situation_assessed: assessed.map(|s| s.label().to_owned()),
+        t_detect_s: None,
+        t_detect_tow_s: None,
+        t_first_action_s: None,
+        first_action: None,
+        r_first_action_m: None,
+        course_change_deg: None,
+        course_change_starboard_deg: None,
+        course_change_port_deg: None,
+        t_cpa_s: cpa.t,
+        r_cpa_m: r_cpa,
+        r_cpa_ship_lengths: r_cpa / p.ship_length_m,
+        beta_cpa_deg: beta_cpa,
+        alpha_cpa_deg: alpha_cpa,
+        side: if beta_cpa >= 0.0 { "starboard" } else { "port" }.to_owned(),
+        passed: if alpha_cpa > -25.0 && alpha_cpa < 165.0 {
+            "ahead"
+        } else {
+            "astern"
+        }
+        .to_owned(),
+        cpa_at_end_of_log: i_cpa + 1 == samples.len() && samples.len() > 1,
+        verdict: "no encounter".to_owned(),
+        reasons: Vec::new(),
+        rule: None,
+        score: None,
+        scores: None,
+        params: *p,
+    };
+    let Some(i_det) = i_det else {
+        report
+            .reasons
+            .push(format!("never within r_detect = {:.2} m", p.r_detect_m));
+        return Some(report);
+    };
+    report.t_detect_s = Some(samples[i_det].t);
+    let i_tow = samples[..=i_cpa]
+        .iter()
+        .position(|s| s.tow_range < p.r_detect_m)
+        .map_or(i_det, |i| i.min(i_det));
+    let det = samples[i_tow];
+    report.t_detect_tow_s = Some(det.t);
+
+    // Heading change relative to the heading when the tow detected the target, up to the
+    // CPA.
+    let (mut stbd, mut port) = (0.0f64, 0.0f64);
+    let mut action: Option<(usize, &str)> = None;
+    let altered_at_detection = det.altered.unwrap_or(false);
+    let mut was_altered = altered_at_detection;
+    for (i, s) in samples.iter().enumerate().take(i_cpa + 1).skip(i_tow) {
+        let dev = wrap(s.own[2] - det.own[2]).to_degrees();
+        stbd = stbd.max(dev);
+        port = port.max(-dev);
+        let altered = s.altered.unwrap_or(false);
+        if action.is_none() {
+            if altered && !was_altered {
+                action = Some((i, "reference altered (waypoint altering, eq. (10)-(11))"));
+            } else if dev.abs() >= p.action_threshold_deg {
+                action = Some((
+                    i,
+                    if dev > 0.0 {
+                        "heading change to starboard"
+                    } else {
+                        "heading change to port"
+                    },
+                ));
+            }
+        }
+        was_altered = altered;
+    }
+    report.course_change_starboard_deg = Some(stbd);
+    report.course_change_port_deg = Some(port);
+    report.course_change_deg = Some(if stbd >= port { stbd } else { -port });
+    let r_manoeuvre = match action {
+        Some((i, what)) => {
+            report.t_first_action_s = Some(samples[i].t);
+            report.first_action = Some(what.to_owned());
+            let r = range(&samples[i]);
+            report.r_first_action_m = Some(r);
+            r
+        }
+        None => r_cpa,
+    };
+    let speed_change = (cpa.own[3] - det.own[3]) / det.own[3].abs().max(1e-3);
+    let sc = scores(
+        r_cpa,
+        alpha_cpa,
+        beta_cpa,
+        r_manoeuvre,
+        stbd,
+        port,
+        speed_change,
+        p,
+    );
+
+    // Binary checks (the PSB-MPC evaluator's, reference/colregs.md) and the rule score.
+    let mut reasons = Vec::new();
+    if r_cpa < p.r_col_m {
+        reasons.push(format!(
+            "closest range {r_cpa:.2} m below the collision range {:.2} m",
+            p.r_col_m
+        ));
+    }
+    let port_turn = port >= p.port_turn_deg && port > stbd;
+    // Rule 16: a give-way vessel takes early and substantial action; none at all between
+    // detection and the CPA is a violation (a small one only lowers the score, P_na).
+    let give_way = matches!(
+        assessed,
+        Some(Situation::HeadOn | Situation::CrossingGiveWay | Situation::Overtaking)
+    );
+    if give_way && action.is_none() {
+        reasons.push("no give-way action between detection and the CPA (Rule 16)".to_owned());
+    }
+    let (rule, score) = match assessed {
+        Some(Situation::HeadOn) => {
+            if beta_cpa > 0.0 {
+                reasons.push("passed starboard to starboard (Rule 14: port to port)".to_owned());
+            }
+            if port_turn {
+                reasons.push(format!("turned {port:.0} deg to port (Rule 14)"));
+            }
+            (Some(14), Some(sc.rule14))
+        }
+        Some(Situation::CrossingGiveWay) => {
+            if sc.p_ahead_rule15 > 0.0 {
+                reasons.push("passed ahead of the target (Rule 15)".to_owned());
+            }
+            if port_turn {
+                reasons.push(format!(
+                    "turned {port:.0} deg to port for a target on the starboard side (Rule 15)"
+                ));
+            }
+            (Some(15), Some(sc.rule15))
+        }
+        Some(Situation::CrossingStandOn) => {
+            if port_turn {
+                reasons.push(format!(
+                    "turned {port:.0} deg to port for a vessel on own port side (Rule 17(c))"
+                ));
+            }
+            (Some(17), Some(sc.rule17))
+        }
+        Some(Situation::Overtaking) => (Some(13), Some(sc.rule13)),
+        Some(Situation::BeingOvertaken) => (Some(17), Some(sc.rule17)),
+        Some(Situation::Unclassified) => (Some(16), Some(sc.rule16)),
+        Some(Situation::Safe) | None => (None, None),
+    };
+    report.verdict = if reasons.is_empty() {
+        "compliant"
+    } else {
+        "violation"
+    }
+    .to_owned();
+    report.reasons = reasons;
+    report.rule = rule;
+    report.score = score;
+    report.scores = Some(sc);
+    Some(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    fn params() -> ScoringParams {
+        ScoringParams::model_scale(1.255, 1.48, 7.0, 0.25)
+    }
+
+    #[test]
+    fn model_scale_ratios() {
+        let p = params();
+        assert!((p.r_col_m - 1.3675).abs() < 1e-12);
+        assert!((p.r_nm_m - 2.245).abs() < 1e-12);
+        assert!((p.r_min_m - 4.49).abs() < 1e-12);
+        assert!((range_score(10.0, &p) - 1.0).abs() < 1e-12);
+        assert!((range_score(p.r_nm_m, &p) - 0.6).abs() < 1e-12);
+        assert!(range_score(p.r_col_m, &p).abs() < 1e-12);
+        assert_eq!(range_score(0.5, &p), 0.0);
+    }
+
+    #[test]
+    fn classification_sectors() {
+        assert_eq!(classify(5.0, -5.0, 0.1, 0.07), Situation::HeadOn);
+        assert_eq!(classify(60.0, -60.0, 0.1, 0.07), Situation::CrossingGiveWay);
+        assert_eq!(classify(-60.0, 60.0, 0.1, 0.07), Situation::CrossingStandOn);
+        assert_eq!(classify(10.0, 170.0, 0.2, 0.07), Situation::Overtaking);
+        assert_eq!(classify(170.0, 10.0, 0.05, 0.2), Situation::BeingOvertaken);
+    }
+
+    /// Own ship heads North at `u` from (0, 0), turning by `turn` (rad, + starboard) at
+    /// `t_turn`; target from (`x0`, `y0`) on `course` at `vt`.
+    #[allow(clippy::too_many_arguments)]
+    fn run(
+        turn: f64,
+        t_turn: f64,
+        x0: f64,
+        y0: f64,
+        course: f64,
+        vt: f64,
+        u: f64,
+    ) -> Vec<EncounterSample> {
+        let dt = 0.5;
+        let (mut x, mut y) = (0.0, 0.0);
+        let mut out = Vec::new();
+        for k in 0..500 {
+            let t = k as f64 * dt;
+            let psi = if t >= t_turn { turn } else { 0.0 };
+            out.push(EncounterSample {
+                t,
+                own: [x, y, psi, u],
+                target: [
+                    x0 + vt * t * course.cos(),
+                    y0 + vt * t * course.sin(),
+                    course,
+                    vt,
+                ],
+                altered: Some(t >= t_turn && turn != 0.0),
+                tow_range: f64::INFINITY,
+            });
+            x += u * dt * psi.cos();
+            y += u * dt * psi.sin();
+        }
+        out
+    }
+
+    #[test]
+    fn head_on_port_to_port_beats_starboard_to_starboard() {
+        let p = params();
+        // Target comes South 0.5 m to port of own track (the paper's C). Own ship turns
+        // 30 deg to starboard at 140 s (detection at 135 s): passes port to port. Turning
+        // 30 deg to port: starboard to starboard.
+        let good = run(30f64.to_radians(), 140.0, 30.0, -0.5, PI, 0.07, 0.1);
+        let bad = run(-30f64.to_radians(), 140.0, 30.0, -0.5, PI, 0.07, 0.1);
+        let view = ControllerView {
+            situation_codes: vec![0, 1, 1],
+            roles: vec!["none".into(), "give-way".into(), "give-way".into()],
+        };
+        let g = assess("C", 6, &good, Some(&view), &p).expect("report");
+        let b = assess("C", 6, &bad, Some(&view), &p).expect("report");
+        assert_eq!(g.situation.as_deref(), Some("head-on"));
+        assert_eq!(g.role.as_deref(), Some("give-way"));
+        assert_eq!(g.situation_geometric.as_deref(), Some("head-on"));
+        assert_eq!(g.side, "port");
+        assert_eq!(b.side, "starboard");
+        assert_eq!(g.verdict, "compliant", "{:?}", g.reasons);
+        assert_eq!(b.verdict, "violation");
+        assert!(b
+            .reasons
+            .iter()
+            .any(|r| r.contains("starboard to starboard")));
+        assert_eq!(g.rule, Some(14));
+        let (gs, bs) = (g.score.expect("score"), b.score.expect("score"));
+        assert!(
+            gs > bs + 0.3,
+            "port-to-port {gs} vs starboard-to-starboard {bs}"
+        );
+        assert!(bs < 0.05, "{bs}");
+        // The first action is the alteration at 140 s.
+        assert_eq!(g.t_first_action_s, Some(140.0));
+        assert!((g.course_change_deg.expect("dchi") - 30.0).abs() < 1e-9);
+        assert!((b.course_change_deg.expect("dchi") + 30.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn an_action_when_a_tug_detects_the_target_counts() {
+        let p = params();
+        // The turn at 128 s comes after the forward tug (2 m ahead) is within 7 m of the
+        // target (about 123.5 s) but before the ship is (135.3 s).
+        let mut samples = run(30f64.to_radians(), 128.0, 30.0, -0.5, PI, 0.07, 0.1);
+        let view = ControllerView {
+            situation_codes: vec![1],
+            roles: vec!["give-way".into()],
+        };
+        let ship_only = assess("C", 6, &samples, Some(&view), &p).expect("report");
+        assert!(ship_only.t_first_action_s.is_none());
+        assert_eq!(ship_only.verdict, "violation");
+        for s in &mut samples {
+            let r = (s.target[0] - s.own[0]).hypot(s.target[1] - s.own[1]);
+            s.tow_range = r - 2.0;
+        }
+        let tow = assess("C", 6, &samples, Some(&view), &p).expect("report");
+        assert_eq!(tow.t_first_action_s, Some(128.0));
+        assert!(tow.t_detect_tow_s.expect("tow") < tow.t_detect_s.expect("ship"));
+        assert_eq!(tow.verdict, "compliant", "{:?}", tow.reasons);
+        // Acting before the ship's detection range: no delay penalty.
+        assert_eq!(tow.scores.expect("scores").p_delay, 0.0);
+    }
+
+    #[test]
+    fn crossing_give_way_astern_beats_ahead() {
+        let p = params();
+        // Target crosses from starboard to port (course West) ahead of own ship.
+        // Passing astern: turn to starboard (towards where the target comes from, behind
+        // it). Passing ahead: keep course and be faster than the target's crossing.
+        let view = ControllerView {
+            situation_codes: vec![2],
+            roles: vec!["give-way".into()],
+        };
+        let astern = run(60f64.to_radians(), 20.0, 6.0, 4.0, -PI / 2.0, 0.07, 0.1);
+        let ahead = run(0.0, 20.0, 5.0, 3.0, -PI / 2.0, 0.07, 0.25);
+        let a = assess("A", 4, &astern, Some(&view), &p).expect("report");
+        let h = assess("A", 4, &ahead, Some(&view), &p).expect("report");
+        assert_eq!(a.passed, "astern", "alpha {}", a.alpha_cpa_deg);
+        assert_eq!(h.passed, "ahead", "alpha {}", h.alpha_cpa_deg);
+        assert_eq!(a.verdict, "compliant", "{:?}", a.reasons);
+        assert_eq!(h.verdict, "violation");
+        assert!(h.reasons.iter().any(|r| r.contains("ahead")));
+        assert_eq!(a.rule, Some(15));
+        assert!(a.score.expect("score") > h.score.expect("score"));
+        // Geometry at detection agrees with the controller.
+        assert_eq!(a.situation_geometric.as_deref(), Some("crossing give-way"));
+    }
+
+    #[test]
+    fn never_detected() {
+        let p = params();
+        let far = run(0.0, 20.0, 30.0, 20.0, PI, 0.07, 0.1);
+        let r = assess("B", 5, &far, None, &p).expect("report");
+        assert_eq!(r.verdict, "no encounter");
+        assert!(r.t_detect_s.is_none());
+        assert!(r.r_cpa_m > 7.0);
+    }
+}

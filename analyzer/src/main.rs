@@ -1,0 +1,113 @@
+//! `analyzer report --out DIR LOG...` and `analyzer compare --out DIR RUN_DIR...`
+//! (docs/analyzer.md).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Metrics, plots and reports from the towing co-simulation's MCAP logs.
+#[derive(Debug, Parser)]
+#[command(name = "analyzer", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Analyse one run: its plant and controller logs (any order).
+    Report {
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bars.
+        #[arg(long, short)]
+        quiet: bool,
+        /// The run's MCAP logs (plant and controller).
+        #[arg(required = true)]
+        logs: Vec<PathBuf>,
+    },
+    /// Compare report directories in the layout of the paper's Tables 6 and 7.
+    Compare {
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bars.
+        #[arg(long, short)]
+        quiet: bool,
+        /// Directories written by `analyzer report`.
+        #[arg(required = true)]
+        runs: Vec<PathBuf>,
+    },
+}
+
+#[allow(clippy::print_stdout)]
+fn main() -> ExitCode {
+    // Library code returns errors; should anything still panic, say so in one line.
+    std::panic::set_hook(Box::new(|info| {
+        eprintln!("analyzer: internal error: {info}");
+    }));
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Report { out, quiet, logs } => match analyzer::report(&out, &logs, quiet) {
+            Ok(outcome) => {
+                let m = &outcome.metrics;
+                for t in &m.truncated_files {
+                    eprintln!(
+                        "warning: {}: {}; the report covers what was read",
+                        t.file, t.reason
+                    );
+                }
+                println!(
+                    "report written to {} ({} files){}",
+                    out.display(),
+                    outcome.written.len(),
+                    if m.truncated {
+                        ", from a TRUNCATED log"
+                    } else {
+                        ""
+                    }
+                );
+                println!(
+                    "settling time: {}; max elongation error: {} / {}; ship travel {:.2} m; collisions {}; bound violations {}; fallbacks {}",
+                    m.settling_time_s
+                        .map_or_else(|| "never settled".to_owned(), |t| format!("{t:.1} s")),
+                    pct(m.max_towline_elongation_error[0]),
+                    pct(m.max_towline_elongation_error[1]),
+                    m.ship_travel_m,
+                    m.collisions,
+                    m.bound_violations.report.total,
+                    m.fallbacks
+                );
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("analyzer report: {e}");
+                ExitCode::FAILURE
+            }
+        },
+        Command::Compare {
+            out,
+            quiet: _,
+            runs,
+        } => match analyzer::compare(&out, &runs) {
+            Ok(outcome) => {
+                println!(
+                    "comparison of {} runs written to {}",
+                    outcome.runs.len(),
+                    out.display()
+                );
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("analyzer compare: {e}");
+                ExitCode::FAILURE
+            }
+        },
+    }
+}
+
+fn pct(v: Option<f64>) -> String {
+    v.map_or_else(|| "-".to_owned(), |v| format!("{:.2} %", v * 100.0))
+}

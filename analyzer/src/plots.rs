@@ -1,0 +1,1068 @@
+//! Plots as PNG and SVG with plotters, headless: no system font is needed (DejaVu Sans
+//! is embedded and registered once), the bitmap and SVG backends draw the same code.
+//!
+//! Axes of the map: East horizontal, North vertical, one metre the same length on both
+//! (`paper/NOTES.md` section 1; the paper's Fig. 8).
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::analysis::{PlotData, TowingSeries};
+use crate::error::{AnalyzerError, Result};
+use crate::geometry::{body_to_ned, circle, ellipse, hull_outline};
+use crate::metrics::rates;
+
+/// DejaVu Sans (Bitstream Vera license, `assets/DejaVuSans-LICENSE.txt`).
+static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+const FAMILY: &str = "sans-serif";
+
+/// Registers the embedded font once.
+fn ensure_font() -> Result<(), String> {
+    static DONE: OnceLock<Result<(), String>> = OnceLock::new();
+    DONE.get_or_init(|| {
+        plotters::style::register_font(FAMILY, FontStyle::Normal, FONT)
+            .map_err(|_| "the embedded DejaVu Sans font does not load".to_owned())?;
+        plotters::style::register_font(FAMILY, FontStyle::Bold, FONT)
+            .map_err(|_| "the embedded DejaVu Sans font does not load".to_owned())
+    })
+    .clone()
+}
+
+/// Size of the states plot (Fig. 12), px.
+pub const STATES_SIZE: (u32, u32) = (1500, 900);
+/// Size of the towing angle and force plot (Fig. 13), px.
+pub const TOWING_SIZE: (u32, u32) = (1400, 900);
+/// Size of the rates plot (Fig. 14), px.
+pub const RATES_SIZE: (u32, u32) = (1400, 900);
+/// Size of the ADMM plot, px.
+pub const ADMM_SIZE: (u32, u32) = (1400, 900);
+/// Size of the compute-time histogram, px.
+pub const HISTOGRAM_SIZE: (u32, u32) = (1000, 600);
+/// Width of the map, px (its height follows the data for an equal aspect).
+pub const MAP_WIDTH: u32 = 1600;
+/// Width of the distance plot, px; its height is [`DISTANCE_ROW_HEIGHT`] per row of two
+/// obstacles.
+pub const DISTANCES_WIDTH: u32 = 1400;
+/// Height of one row of the distance plot, px.
+pub const DISTANCE_ROW_HEIGHT: u32 = 320;
+
+/// Target-ship positions farther than this from the ship (m) do not widen the map.
+const MAP_TARGET_RANGE: f64 = 12.0;
+
+/// Most points drawn per line (min/max per bucket beyond that).
+const MAX_POINTS: usize = 4000;
+
+const SHIP: RGBColor = RGBColor(200, 30, 30);
+const TUG1: RGBColor = RGBColor(20, 140, 40);
+const TUG2: RGBColor = RGBColor(30, 70, 200);
+const TARGET: RGBColor = RGBColor(150, 60, 160);
+const HAZARD: RGBColor = RGBColor(90, 90, 90);
+const BOUND: RGBColor = RGBColor(220, 60, 20);
+const ROUTE: RGBColor = RGBColor(120, 120, 120);
+const ALTERED: RGBColor = RGBColor(240, 150, 0);
+
+/// One written plot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlotFile {
+    /// File stem (`map`, `states`, ...).
+    pub stem: String,
+    /// Caption for the report.
+    pub title: String,
+    /// The PNG.
+    pub png: PathBuf,
+    /// The SVG.
+    pub svg: PathBuf,
+    /// Size, px.
+    pub size: (u32, u32),
+}
+
+type DrawResult = std::result::Result<(), Box<dyn std::error::Error>>;
+
+/// Line styles of a series.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Dash {
+    Solid,
+    Dashed,
+    Dotted,
+}
+
+#[derive(Debug, Clone)]
+struct Line {
+    label: String,
+    pts: Vec<(f64, f64)>,
+    color: RGBColor,
+    width: u32,
+    dash: Dash,
+}
+
+#[derive(Debug, Clone)]
+struct Panel {
+    title: String,
+    y_desc: String,
+    lines: Vec<Line>,
+    /// Horizontal bound lines (value, label).
+    bounds: Vec<(f64, String)>,
+}
+
+/// Keeps a line under [`MAX_POINTS`] points: beyond that, the first, min, max and last
+/// point of each bucket, in time order.
+fn decimate(t: &[f64], v: &[f64]) -> Vec<(f64, f64)> {
+    let pts: Vec<(f64, f64)> = t
+        .iter()
+        .zip(v)
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .map(|(&a, &b)| (a, b))
+        .collect();
+    if pts.len() <= MAX_POINTS {
+        return pts;
+    }
+    let buckets = MAX_POINTS / 4;
+    let per = pts.len().div_ceil(buckets);
+    let mut out = Vec::with_capacity(MAX_POINTS);
+    for chunk in pts.chunks(per) {
+        let (mut lo, mut hi) = (0, 0);
+        for (k, p) in chunk.iter().enumerate() {
+            if p.1 < chunk[lo].1 {
+                lo = k;
+            }
+            if p.1 > chunk[hi].1 {
+                hi = k;
+            }
+        }
+        let mut idx = vec![0, lo, hi, chunk.len() - 1];
+        idx.sort_unstable();
+        idx.dedup();
+        out.extend(idx.into_iter().map(|k| chunk[k]));
+    }
+    out
+}
+
+fn range_of<'a>(values: impl Iterator<Item = &'a f64>) -> Option<Range<f64>> {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    if lo > hi {
+        return None;
+    }
+    if (hi - lo) < 1e-12 {
+        let pad = if lo.abs() > 1e-12 {
+            lo.abs() * 0.1
+        } else {
+            1.0
+        };
+        return Some(lo - pad..hi + pad);
+    }
+    let pad = 0.05 * (hi - lo);
+    Some(lo - pad..hi + pad)
+}
+
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panel: &Panel,
+    x_range: Range<f64>,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    let y_range = range_of(
+        panel
+            .lines
+            .iter()
+            .flat_map(|l| l.pts.iter().map(|p| &p.1))
+            .chain(panel.bounds.iter().map(|b| &b.0)),
+    )
+    .unwrap_or(-1.0..1.0);
+    let mut chart = ChartBuilder::on(area)
+        .caption(&panel.title, (FAMILY, 18))
+        .margin(8)
+        .x_label_area_size(36)
+        .y_label_area_size(64)
+        .build_cartesian_2d(x_range.clone(), y_range)?;
+    chart
+        .configure_mesh()
+        .x_desc("t (s)")
+        .y_desc(panel.y_desc.as_str())
+        .label_style((FAMILY, 13))
+        .axis_desc_style((FAMILY, 14))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()?;
+    for (value, label) in &panel.bounds {
+        let style = BOUND.stroke_width(1);
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(x_range.start, *value), (x_range.end, *value)],
+                8,
+                5,
+                style,
+            ))?
+            .label(label.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+    }
+    let mut labelled = false;
+    for line in &panel.lines {
+        if line.pts.is_empty() {
+            continue;
+        }
+        let style = line.color.stroke_width(line.width);
+        let anno = match line.dash {
+            Dash::Solid => chart.draw_series(LineSeries::new(line.pts.iter().copied(), style))?,
+            Dash::Dashed => chart.draw_series(DashedLineSeries::new(
+                line.pts.iter().copied(),
+                10,
+                5,
+                style,
+            ))?,
+            Dash::Dotted => {
+                chart.draw_series(DashedLineSeries::new(line.pts.iter().copied(), 3, 4, style))?
+            }
+        };
+        if !line.label.is_empty() {
+            labelled = true;
+            anno.label(line.label.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        }
+    }
+    if labelled || !panel.bounds.is_empty() {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(180, 180, 180))
+            .label_font((FAMILY, 12))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()?;
+    }
+    Ok(())
+}
+
+fn draw_panels<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    panels: &[Panel],
+    cols: usize,
+    x_range: Range<f64>,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let root = root.titled(title, (FAMILY, 22))?;
+    let rows = panels.len().div_ceil(cols).max(1);
+    let areas = root.split_evenly((rows, cols));
+    for (panel, area) in panels.iter().zip(areas.iter()) {
+        draw_panel(area, panel, x_range.clone())?;
+    }
+    Ok(())
+}
+
+fn x_range(t: &[f64]) -> Range<f64> {
+    let lo = t.iter().copied().find(|v| v.is_finite()).unwrap_or(0.0);
+    let hi = t
+        .iter()
+        .rev()
+        .copied()
+        .find(|v| v.is_finite())
+        .unwrap_or(1.0);
+    if hi > lo {
+        lo..hi
+    } else {
+        lo..lo + 1.0
+    }
+}
+
+fn vessel_lines(d: &PlotData<'_>, f: impl Fn(usize) -> Vec<f64>) -> Vec<Line> {
+    let styles = [
+        ("ship", SHIP, 2, Dash::Solid),
+        ("tug 1 (aft)", TUG1, 1, Dash::Dashed),
+        ("tug 2 (forward)", TUG2, 1, Dash::Dotted),
+    ];
+    styles
+        .iter()
+        .enumerate()
+        .map(|(k, (label, color, width, dash))| Line {
+            label: (*label).to_owned(),
+            pts: decimate(&d.t, &f(k)),
+            color: *color,
+            width: *width,
+            dash: *dash,
+        })
+        .collect()
+}
+
+fn states_panels(d: &PlotData<'_>) -> Vec<Panel> {
+    let v = &d.vessels;
+    let deg = |x: &[f64]| x.iter().map(|a| a.to_degrees()).collect::<Vec<_>>();
+    // Headings unwrapped (no jump at +-180 deg when heading South).
+    let unwrapped = |x: &[f64]| {
+        let mut out = Vec::with_capacity(x.len());
+        let mut prev: Option<f64> = None;
+        for &a in x {
+            let v = match prev {
+                Some(p) if a.is_finite() => p + crate::geometry::wrap(a - p),
+                _ => a,
+            };
+            if v.is_finite() {
+                prev = Some(v);
+            }
+            out.push(v.to_degrees());
+        }
+        out
+    };
+    vec![
+        Panel {
+            title: "x (North)".into(),
+            y_desc: "x (m)".into(),
+            lines: vessel_lines(d, |k| v[k].x.to_vec()),
+            bounds: vec![],
+        },
+        Panel {
+            title: "y (East)".into(),
+            y_desc: "y (m)".into(),
+            lines: vessel_lines(d, |k| v[k].y.to_vec()),
+            bounds: vec![],
+        },
+        Panel {
+            title: "heading psi".into(),
+            y_desc: "psi (deg)".into(),
+            lines: vessel_lines(d, |k| unwrapped(&v[k].psi)),
+            bounds: vec![],
+        },
+        Panel {
+            title: "surge u".into(),
+            y_desc: "u (m/s)".into(),
+            lines: vessel_lines(d, |k| v[k].u.to_vec()),
+            bounds: vec![],
+        },
+        Panel {
+            title: "sway v".into(),
+            y_desc: "v (m/s)".into(),
+            lines: vessel_lines(d, |k| v[k].v.to_vec()),
+            bounds: vec![],
+        },
+        Panel {
+            title: "yaw rate r".into(),
+            y_desc: "r (deg/s)".into(),
+            lines: vessel_lines(d, |k| deg(&v[k].r)),
+            bounds: vec![],
+        },
+    ]
+}
+
+fn towing_panels(d: &PlotData<'_>, rate: bool) -> Vec<Panel> {
+    let b = &d.bounds;
+    let mut panels = Vec::new();
+    let commanded = d.command.as_ref();
+    for line in 0..2 {
+        let mut lines = Vec::new();
+        let series = |s: &TowingSeries<'_>, label: &str, color: RGBColor, width: u32| -> Line {
+            let v: Vec<f64> = s.angle[line].iter().map(|a| a.to_degrees()).collect();
+            let v = if rate { rates(&s.t, &v) } else { v };
+            Line {
+                label: label.to_owned(),
+                pts: decimate(&s.t, &v),
+                color,
+                width,
+                dash: Dash::Solid,
+            }
+        };
+        if !rate {
+            lines.push(series(
+                &d.actual,
+                "actual (plant)",
+                RGBColor(150, 150, 150),
+                1,
+            ));
+        }
+        if let Some(c) = commanded {
+            lines.push(series(
+                c,
+                "commanded",
+                if line == 0 { TUG1 } else { TUG2 },
+                2,
+            ));
+        }
+        let (lim, unit) = if rate {
+            (b.angle_rate_rad_per_s.to_degrees(), "deg/s")
+        } else {
+            (b.max_towing_angle_rad.to_degrees(), "deg")
+        };
+        panels.push(Panel {
+            title: format!(
+                "towing angle alpha{}{}",
+                line + 1,
+                if rate { " rate" } else { "" }
+            ),
+            y_desc: if rate {
+                format!("d alpha{}/dt ({unit})", line + 1)
+            } else {
+                format!("alpha{} ({unit})", line + 1)
+            },
+            lines,
+            bounds: vec![
+                (lim, format!("+{lim:.3} {unit}")),
+                (-lim, format!("-{lim:.3} {unit}")),
+            ],
+        });
+    }
+    for line in 0..2 {
+        let mut lines = Vec::new();
+        let series = |s: &TowingSeries<'_>, label: &str, color: RGBColor, width: u32| -> Line {
+            let v = &s.tension[line];
+            let v = if rate { rates(&s.t, v) } else { v.to_vec() };
+            Line {
+                label: label.to_owned(),
+                pts: decimate(&s.t, &v),
+                color,
+                width,
+                dash: Dash::Solid,
+            }
+        };
+        if !rate {
+            lines.push(series(
+                &d.actual,
+                "actual (plant)",
+                RGBColor(150, 150, 150),
+                1,
+            ));
+        }
+        if let Some(c) = commanded {
+            lines.push(series(
+                c,
+                "commanded",
+                if line == 0 { TUG1 } else { TUG2 },
+                2,
+            ));
+        }
+        let bounds = if rate {
+            let r = b.tension_rate_n_per_s;
+            vec![(r, format!("+{r} N/s")), (-r, format!("-{r} N/s"))]
+        } else {
+            vec![
+                (b.max_tension_n, format!("{} N", b.max_tension_n)),
+                (b.min_tension_n, format!("{} N", b.min_tension_n)),
+            ]
+        };
+        panels.push(Panel {
+            title: format!(
+                "towing force F{}{}",
+                line + 1,
+                if rate { " rate" } else { "" }
+            ),
+            y_desc: if rate {
+                format!("dF{}/dt (N/s)", line + 1)
+            } else {
+                format!("F{} (N)", line + 1)
+            },
+            lines,
+            bounds,
+        });
+    }
+    panels
+}
+
+fn distance_panels(d: &PlotData<'_>) -> Vec<Panel> {
+    d.obstacles
+        .iter()
+        .map(|o| {
+            let styles = [
+                ("ship", SHIP, 2, Dash::Solid),
+                ("tug 1", TUG1, 1, Dash::Dashed),
+                ("tug 2", TUG2, 1, Dash::Dotted),
+            ];
+            let lines = styles
+                .iter()
+                .enumerate()
+                .map(|(k, (label, color, width, dash))| Line {
+                    label: (*label).to_owned(),
+                    pts: decimate(&o.t, &o.distance[k]),
+                    color: *color,
+                    width: *width,
+                    dash: *dash,
+                })
+                .collect();
+            let mut bounds = vec![(o.safe[0], format!("safe, ship {:.2} m", o.safe[0]))];
+            if (o.safe[1] - o.safe[0]).abs() > 1e-9 {
+                bounds.push((o.safe[1], format!("safe, tug {:.2} m", o.safe[1])));
+            }
+            Panel {
+                title: format!(
+                    "{} ({})",
+                    o.name,
+                    if o.kind == 2 {
+                        "target ship"
+                    } else {
+                        "static hazard"
+                    }
+                ),
+                y_desc: "centre distance (m)".into(),
+                lines,
+                bounds,
+            }
+        })
+        .collect()
+}
+
+fn admm_panels(d: &PlotData<'_>) -> Vec<Panel> {
+    let Some(s) = &d.solver else {
+        return Vec::new();
+    };
+    let log = |v: &[f64]| {
+        v.iter()
+            .map(|x| if *x > 0.0 { x.log10() } else { f64::NAN })
+            .collect::<Vec<_>>()
+    };
+    vec![
+        Panel {
+            title: "ADMM iterations per sample".into(),
+            y_desc: "iterations".into(),
+            lines: vec![Line {
+                label: String::new(),
+                pts: decimate(&s.t, &s.iterations),
+                color: TUG2,
+                width: 1,
+                dash: Dash::Solid,
+            }],
+            bounds: vec![],
+        },
+        Panel {
+            title: "last residuals (eq. (29))".into(),
+            y_desc: "log10 residual".into(),
+            lines: vec![
+                Line {
+                    label: "primal, tug 1".into(),
+                    pts: decimate(&s.t, &log(&s.r_pri[0])),
+                    color: TUG1,
+                    width: 1,
+                    dash: Dash::Solid,
+                },
+                Line {
+                    label: "primal, tug 2".into(),
+                    pts: decimate(&s.t, &log(&s.r_pri[1])),
+                    color: TUG2,
+                    width: 1,
+                    dash: Dash::Solid,
+                },
+                Line {
+                    label: "dual, tug 1".into(),
+                    pts: decimate(&s.t, &log(&s.r_dual[0])),
+                    color: TUG1,
+                    width: 1,
+                    dash: Dash::Dotted,
+                },
+                Line {
+                    label: "dual, tug 2".into(),
+                    pts: decimate(&s.t, &log(&s.r_dual[1])),
+                    color: TUG2,
+                    width: 1,
+                    dash: Dash::Dotted,
+                },
+            ],
+            bounds: vec![],
+        },
+    ]
+}
+
+fn draw_histogram<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, d: &PlotData<'_>) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let ms: Vec<f64> = d
+        .solver
+        .as_ref()
+        .map(|s| {
+            s.compute_ms
+                .iter()
+                .copied()
+                .filter(|v| v.is_finite())
+                .collect()
+        })
+        .unwrap_or_default();
+    let hi = ms.iter().copied().fold(0.0f64, f64::max).max(1e-3) * 1.02;
+    let bins = 40usize;
+    let width = hi / bins as f64;
+    let mut counts = vec![0u32; bins];
+    for v in &ms {
+        let k = ((v / width) as usize).min(bins - 1);
+        counts[k] += 1;
+    }
+    let top = f64::from(counts.iter().copied().max().unwrap_or(1).max(1)) * 1.1;
+    let mut chart = ChartBuilder::on(root)
+        .caption(
+            format!("computation time per control sample ({} samples)", ms.len()),
+            (FAMILY, 20),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..hi, 0.0..top)?;
+    chart
+        .configure_mesh()
+        .x_desc("compute time (ms)")
+        .y_desc("samples")
+        .label_style((FAMILY, 13))
+        .axis_desc_style((FAMILY, 14))
+        .draw()?;
+    chart.draw_series(counts.iter().enumerate().map(|(k, &c)| {
+        let x0 = k as f64 * width;
+        Rectangle::new(
+            [(x0, 0.0), (x0 + width * 0.92, f64::from(c))],
+            TUG2.filled(),
+        )
+    }))?;
+    Ok(())
+}
+
+/// Size and ranges of the map: `(size px, East range, North range)`, with the plotting
+/// area's metres per pixel equal on both axes.
+#[must_use]
+pub fn map_layout(d: &PlotData<'_>) -> ((u32, u32), Range<f64>, Range<f64>) {
+    let mut east: Vec<f64> = Vec::new();
+    let mut north: Vec<f64> = Vec::new();
+    for p in &d.route {
+        north.push(p[0]);
+        east.push(p[1]);
+    }
+    for v in &d.vessels {
+        north.extend(v.x.iter().copied());
+        east.extend(v.y.iter().copied());
+    }
+    for o in &d.obstacles {
+        // Static hazards always; target ships only where they come near the ship, so a
+        // target's long run-in does not shrink the tow to a line.
+        for i in 0..o.x.len() {
+            let near = o.distance[0].get(i).is_some_and(|d| *d < MAP_TARGET_RANGE);
+            if o.kind != 2 || near {
+                north.push(o.x[i]);
+                east.push(o.y[i]);
+            }
+        }
+    }
+    let pad = 2.0;
+    let er = range_of(east.iter()).unwrap_or(-10.0..10.0);
+    let nr = range_of(north.iter()).unwrap_or(-10.0..10.0);
+    let (mut e0, mut e1) = (er.start - pad, er.end + pad);
+    let (mut n0, mut n1) = (nr.start - pad, nr.end + pad);
+    // Plot area: width minus label area and margins; height plus caption and labels.
+    let plot_w = f64::from(MAP_WIDTH - 70 - 40);
+    let extra_h = 40.0 + 50.0 + 40.0;
+    let mut plot_h = plot_w * (n1 - n0) / (e1 - e0);
+    let (min_h, max_h) = (500.0 - extra_h, 2400.0 - extra_h);
+    if plot_h > max_h {
+        // Too tall: widen East around its centre.
+        let want = (n1 - n0) * plot_w / max_h;
+        let c = 0.5 * (e0 + e1);
+        e0 = c - want / 2.0;
+        e1 = c + want / 2.0;
+        plot_h = max_h;
+    } else if plot_h < min_h {
+        let want = (e1 - e0) * min_h / plot_w;
+        let c = 0.5 * (n0 + n1);
+        n0 = c - want / 2.0;
+        n1 = c + want / 2.0;
+        plot_h = min_h;
+    }
+    let h = (plot_h + extra_h).round() as u32;
+    ((MAP_WIDTH, h), e0..e1, n0..n1)
+}
+
+/// Indices of `n` evenly spaced sample times (the paper's Fig. 8 shows ten states).
+fn sample_indices(t: &[f64], n: usize) -> Vec<usize> {
+    if t.is_empty() {
+        return Vec::new();
+    }
+    let (t0, t1) = (t[0], t[t.len() - 1]);
+    (0..n)
+        .map(|k| {
+            let target = t0 + (t1 - t0) * k as f64 / (n - 1).max(1) as f64;
+            t.partition_point(|&v| v < target).min(t.len() - 1)
+        })
+        .collect()
+}
+
+fn en(p: [f64; 2]) -> (f64, f64) {
+    (p[1], p[0])
+}
+
+fn draw_map<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    d: &PlotData<'_>,
+    er: Range<f64>,
+    nr: Range<f64>,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(root)
+        .caption(format!("map: {}", d.title), (FAMILY, 22))
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(70)
+        .build_cartesian_2d(er, nr)?;
+    chart
+        .configure_mesh()
+        .x_desc("East y (m)")
+        .y_desc("North x (m)")
+        .label_style((FAMILY, 14))
+        .axis_desc_style((FAMILY, 16))
+        .light_line_style(RGBColor(238, 238, 238))
+        .draw()?;
+
+    // Route and waypoints.
+    let route: Vec<(f64, f64)> = d.route.iter().map(|p| (p[1], p[0])).collect();
+    chart
+        .draw_series(DashedLineSeries::new(
+            route.iter().copied(),
+            10,
+            6,
+            ROUTE.stroke_width(2),
+        ))?
+        .label("route")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], ROUTE.stroke_width(2)));
+    chart.draw_series(route.iter().map(|&p| Circle::new(p, 4, ROUTE.filled())))?;
+    if let Some(&dest) = route.last() {
+        chart.draw_series(std::iter::once(Cross::new(dest, 9, BLACK.stroke_width(3))))?;
+    }
+    if !d.altered_waypoints.is_empty() {
+        chart
+            .draw_series(
+                d.altered_waypoints
+                    .iter()
+                    .map(|w| TriangleMarker::new((w[1], w[0]), 8, ALTERED.filled())),
+            )?
+            .label("altered waypoints")
+            .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, ALTERED.filled()));
+    }
+
+    // Static hazards with their safe circles (ship's safe distance, eq. (14)).
+    let mut hazard_legend = false;
+    for o in d.obstacles.iter().filter(|o| o.kind != 2) {
+        let (Some(&x), Some(&y)) = (o.x.first(), o.y.first()) else {
+            continue;
+        };
+        let r = o.length.max(o.width) / 2.0;
+        let body: Vec<(f64, f64)> = circle(x, y, r, 48).into_iter().map(en).collect();
+        let a = chart.draw_series(std::iter::once(Polygon::new(
+            body,
+            HAZARD.mix(0.6).filled(),
+        )))?;
+        if !hazard_legend {
+            a.label("static hazard")
+                .legend(|(x, y)| Circle::new((x + 10, y), 5, HAZARD.filled()));
+        }
+        let mut safe: Vec<(f64, f64)> = circle(x, y, o.safe[0], 96).into_iter().map(en).collect();
+        if let Some(&first) = safe.first() {
+            safe.push(first);
+        }
+        let a = chart.draw_series(DashedLineSeries::new(safe, 6, 5, BOUND.stroke_width(1)))?;
+        if !hazard_legend {
+            a.label("safe distance (ship)")
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BOUND));
+            hazard_legend = true;
+        }
+        chart.draw_series(std::iter::once(Text::new(
+            o.name.clone(),
+            (y + r * 0.9, x + r * 0.9),
+            (FAMILY, 18).into_font().color(&BLACK),
+        )))?;
+    }
+
+    // Target ships: tracks, and outlines at the sampled times when active.
+    let samples = sample_indices(&d.t, 10);
+    let sample_times: Vec<f64> = samples.iter().map(|&i| d.t[i]).collect();
+    let mut target_legend = false;
+    for o in d.obstacles.iter().filter(|o| o.kind == 2) {
+        let track: Vec<(f64, f64)> = o.x.iter().zip(&o.y).map(|(&x, &y)| (y, x)).collect();
+        let track = if track.len() > MAX_POINTS {
+            track
+                .iter()
+                .step_by(track.len() / MAX_POINTS + 1)
+                .copied()
+                .collect()
+        } else {
+            track
+        };
+        let a = chart.draw_series(LineSeries::new(track, TARGET.stroke_width(1)))?;
+        if !target_legend {
+            a.label("target ships")
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], TARGET));
+            target_legend = true;
+        }
+        // The track may be thinned (analysis::PLOT_ROWS): accept the nearest kept row.
+        let spacing = match (o.t.first(), o.t.last()) {
+            (Some(a), Some(b)) if o.t.len() > 1 => (b - a) / (o.t.len() - 1) as f64,
+            _ => 0.0,
+        };
+        let tolerance = (2.0 * spacing).max(1.0);
+        for &ts in &sample_times {
+            let k = o.t.partition_point(|&v| v < ts);
+            if k >= o.t.len() || (o.t[k] - ts).abs() > tolerance {
+                continue;
+            }
+            let mut outline: Vec<(f64, f64)> =
+                ellipse(o.x[k], o.y[k], o.psi[k], o.length / 2.0, o.width / 2.0, 40)
+                    .into_iter()
+                    .map(en)
+                    .collect();
+            chart.draw_series(std::iter::once(Polygon::new(
+                outline.clone(),
+                TARGET.mix(0.25).filled(),
+            )))?;
+            if let Some(&f) = outline.first() {
+                outline.push(f);
+            }
+            chart.draw_series(std::iter::once(PathElement::new(outline, TARGET)))?;
+            let bow = body_to_ned(o.x[k], o.y[k], o.psi[k], o.length / 2.0, 0.0);
+            chart.draw_series(std::iter::once(Circle::new(en(bow), 2, TARGET.filled())))?;
+        }
+        if let (Some(&x), Some(&y)) = (o.x.first(), o.y.first()) {
+            chart.draw_series(std::iter::once(Text::new(
+                o.name.clone(),
+                (y + 0.5, x),
+                (FAMILY, 18).into_font().color(&TARGET),
+            )))?;
+        }
+    }
+
+    // The tow: tracks, then hull outlines and towlines at the sampled times.
+    let colors = [SHIP, TUG1, TUG2];
+    let labels = ["ship", "tug 1 (aft)", "tug 2 (forward)"];
+    for k in 0..3 {
+        let v = &d.vessels[k];
+        // decimate() keeps the samples' order, so the track stays a path.
+        let pts = decimate(&v.y, &v.x);
+        let color = colors[k];
+        chart
+            .draw_series(LineSeries::new(
+                pts,
+                color.stroke_width(if k == 0 { 2 } else { 1 }),
+            ))?
+            .label(labels[k])
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            });
+    }
+    for &i in &samples {
+        let pose = |k: usize| {
+            let v = &d.vessels[k];
+            (v.x[i], v.y[i], v.psi[i])
+        };
+        let (sx, sy, sp) = pose(0);
+        if !(sx.is_finite() && sy.is_finite() && sp.is_finite()) {
+            continue;
+        }
+        // Towlines: ship stern to tug 1 bow, ship bow to tug 2 stern (attachment points
+        // approximated by the hull ends).
+        let ls = d.sizes[0][0] / 2.0;
+        for (k, ship_end, tug_end) in [
+            (1usize, -ls, d.sizes[1][0] / 2.0),
+            (2, ls, -d.sizes[2][0] / 2.0),
+        ] {
+            let (tx, ty, tp) = pose(k);
+            if !(tx.is_finite() && ty.is_finite() && tp.is_finite()) {
+                continue;
+            }
+            let a = body_to_ned(sx, sy, sp, ship_end, 0.0);
+            let b = body_to_ned(tx, ty, tp, tug_end, 0.0);
+            chart.draw_series(std::iter::once(PathElement::new(
+                vec![en(a), en(b)],
+                BLACK.stroke_width(1),
+            )))?;
+        }
+        for (k, color) in colors.iter().enumerate() {
+            let (x, y, p) = pose(k);
+            if !(x.is_finite() && y.is_finite() && p.is_finite()) {
+                continue;
+            }
+            let mut hull: Vec<(f64, f64)> = hull_outline(x, y, p, d.sizes[k][0], d.sizes[k][1])
+                .into_iter()
+                .map(en)
+                .collect();
+            chart.draw_series(std::iter::once(Polygon::new(
+                hull.clone(),
+                color.mix(0.35).filled(),
+            )))?;
+            if let Some(&f) = hull.first() {
+                hull.push(f);
+            }
+            chart.draw_series(std::iter::once(PathElement::new(
+                hull,
+                color.stroke_width(1),
+            )))?;
+        }
+        chart.draw_series(std::iter::once(Text::new(
+            format!("{:.0} s", d.t[i]),
+            (sy + 0.9, sx + 0.4),
+            (FAMILY, 13).into_font().color(&BLACK),
+        )))?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.9))
+        .border_style(RGBColor(180, 180, 180))
+        .label_font((FAMILY, 14))
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()?;
+    Ok(())
+}
+
+fn plot_error(path: &Path, e: impl std::fmt::Display) -> AnalyzerError {
+    AnalyzerError::Plot {
+        path: path.to_owned(),
+        reason: e.to_string(),
+    }
+}
+
+/// Draws `$draw(&root, args...)` into `DIR/STEM.png` and `DIR/STEM.svg`.
+macro_rules! render {
+    ($dir:expr, $stem:expr, $title:expr, $size:expr, $draw:ident $(, $arg:expr)*) => {{
+        let png = $dir.join(format!("{}.png", $stem));
+        let svg = $dir.join(format!("{}.svg", $stem));
+        {
+            let root = BitMapBackend::new(&png, $size).into_drawing_area();
+            $draw(&root $(, $arg)*).map_err(|e| plot_error(&png, e))?;
+            root.present().map_err(|e| plot_error(&png, e))?;
+        }
+        {
+            let root = SVGBackend::new(&svg, $size).into_drawing_area();
+            $draw(&root $(, $arg)*).map_err(|e| plot_error(&svg, e))?;
+            root.present().map_err(|e| plot_error(&svg, e))?;
+        }
+        PlotFile {
+            stem: $stem.to_owned(),
+            title: $title.to_owned(),
+            png,
+            svg,
+            size: $size,
+        }
+    }};
+}
+
+/// Writes every plot into `dir` (PNG and SVG each) and lists them.
+///
+/// # Errors
+/// The font does not load, or a file cannot be drawn or written.
+pub fn write_plots(dir: &Path, d: &PlotData<'_>) -> Result<Vec<PlotFile>> {
+    ensure_font().map_err(|e| plot_error(dir, e))?;
+    let mut out = Vec::new();
+    let (map_size, er, nr) = map_layout(d);
+    out.push(render!(
+        dir,
+        "map",
+        "Map (Fig. 8 style): tracks, hulls every tenth of the run, hazards with the ship's safe distance, target ships, route and altered waypoints",
+        map_size,
+        draw_map,
+        d,
+        er.clone(),
+        nr.clone()
+    ));
+    let xr = x_range(&d.t);
+    let states = states_panels(d);
+    let title = format!("vessel states (Fig. 12 style): {}", d.title);
+    out.push(render!(
+        dir,
+        "states",
+        "Vessel states x, y, psi, u, v, r (Fig. 12 style)",
+        STATES_SIZE,
+        draw_panels,
+        &title,
+        &states,
+        3,
+        xr.clone()
+    ));
+    let towing = towing_panels(d, false);
+    let title = format!("towing angles and forces (Fig. 13 style): {}", d.title);
+    out.push(render!(
+        dir,
+        "towing",
+        "Towing angles and forces with their bounds (Fig. 13 style)",
+        TOWING_SIZE,
+        draw_panels,
+        &title,
+        &towing,
+        2,
+        xr.clone()
+    ));
+    let rate_panels = towing_panels(d, true);
+    let title = format!(
+        "rates of the commanded towing angles and forces (Fig. 14 style): {}",
+        d.title
+    );
+    out.push(render!(
+        dir,
+        "rates",
+        "Rates of the commanded towing angles and forces with the rate bounds (Fig. 14 style)",
+        RATES_SIZE,
+        draw_panels,
+        &title,
+        &rate_panels,
+        2,
+        xr.clone()
+    ));
+    let dist = distance_panels(d);
+    if !dist.is_empty() {
+        let rows = u32::try_from(dist.len().div_ceil(2)).unwrap_or(1);
+        let size = (DISTANCES_WIDTH, DISTANCE_ROW_HEIGHT * rows + 40);
+        let title = format!(
+            "distance to each obstacle (centre distance, eq. (30)): {}",
+            d.title
+        );
+        out.push(render!(
+            dir,
+            "distances",
+            "Distance of each vessel to each obstacle with the safe distances",
+            size,
+            draw_panels,
+            &title,
+            &dist,
+            2,
+            xr.clone()
+        ));
+    }
+    let admm = admm_panels(d);
+    if !admm.is_empty() {
+        let title = format!("ADMM: {}", d.title);
+        out.push(render!(
+            dir,
+            "admm",
+            "ADMM iterations and last residuals per control sample",
+            ADMM_SIZE,
+            draw_panels,
+            &title,
+            &admm,
+            1,
+            xr.clone()
+        ));
+        out.push(render!(
+            dir,
+            "compute_time",
+            "Histogram of the computation time per control sample",
+            HISTOGRAM_SIZE,
+            draw_histogram,
+            d
+        ));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decimation_keeps_extremes_and_order() {
+        let t: Vec<f64> = (0..100_000).map(f64::from).collect();
+        let mut v: Vec<f64> = t.iter().map(|x| (x * 0.001).sin()).collect();
+        v[54_321] = 10.0;
+        let d = decimate(&t, &v);
+        assert!(d.len() <= MAX_POINTS);
+        assert!(d.iter().any(|p| p.1 == 10.0));
+        assert!(d.windows(2).all(|w| w[0].0 <= w[1].0));
+    }
+}

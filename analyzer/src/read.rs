@@ -1,0 +1,874 @@
+//! Streaming reader of one MCAP log into column vectors.
+//!
+//! The file is read front to back through a `BufReader` with the MCAP crate's sans-io
+//! [`LinearReader`] (mcap 0.26): memory scales with the largest chunk (1 MiB by default in
+//! the writer), never with the file. Each message of a topic of docs/logging.md is decoded
+//! into its `towing_log::topics` struct and appended to column vectors; the scene, `/tf` and
+//! prediction topics are skipped without decoding (they are most of a log's bytes and the
+//! report does not need them). Besides messages the reader keeps the `run` Metadata record
+//! and the `scenario.toml` attachment.
+//!
+//! A log that ends early (a crashed run, a file being written, a partial copy) stops the
+//! MCAP reader with an error at the first broken record; everything before it is kept and
+//! the file is marked [`LogFile::truncated`].
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{BufReader, Read};
+use std::path::{Path, PathBuf};
+
+use mcap::records::Record;
+use mcap::sans_io::{LinearReadEvent, LinearReader};
+use mcap::McapError;
+use serde::de::DeserializeOwned;
+use towing_log::topics::{
+    self, metadata_keys, names, Colregs, Command, Log, Obstacles, PlantInputs, Reference, Solver,
+    TowlineState, VesselState,
+};
+
+use crate::error::{AnalyzerError, Result};
+
+/// Which FMU wrote a log.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unit {
+    /// `TowingPlant`: topics `/plant/...`.
+    Plant,
+    /// `TowingController`: topics `/controller/...`.
+    Controller,
+    /// Both prefixes in one file (a merged log).
+    Both,
+}
+
+impl Unit {
+    /// Lower-case name for messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Unit::Plant => "plant",
+            Unit::Controller => "controller",
+            Unit::Both => "plant and controller",
+        }
+    }
+}
+
+/// Columns of one vessel topic (`towing.VesselState`).
+#[derive(Debug, Default, Clone)]
+pub struct VesselCols {
+    /// Log time, ns since the epoch (simulation time 0 s).
+    pub t_ns: Vec<i64>,
+    /// North, m.
+    pub x: Vec<f64>,
+    /// East, m.
+    pub y: Vec<f64>,
+    /// Heading, rad.
+    pub psi: Vec<f64>,
+    /// Surge, m/s.
+    pub u: Vec<f64>,
+    /// Sway, m/s.
+    pub v: Vec<f64>,
+    /// Yaw rate, rad/s.
+    pub r: Vec<f64>,
+}
+
+impl VesselCols {
+    fn push(&mut self, t_ns: i64, m: VesselState) {
+        self.t_ns.push(t_ns);
+        self.x.push(m.x);
+        self.y.push(m.y);
+        self.psi.push(m.psi);
+        self.u.push(m.u);
+        self.v.push(m.v);
+        self.r.push(m.r);
+    }
+}
+
+/// Columns of one towline topic (`towing.TowlineState`).
+#[derive(Debug, Default, Clone)]
+pub struct TowlineCols {
+    /// Log time, ns.
+    pub t_ns: Vec<i64>,
+    /// Distance between the attachment points, m.
+    pub length: Vec<f64>,
+    /// Towing angle, rad.
+    pub angle: Vec<f64>,
+    /// Mean tension over the step, N.
+    pub tension: Vec<f64>,
+    /// Commanded tension, N.
+    pub tension_cmd: Vec<f64>,
+    /// Slack at the end of the step.
+    pub slack: Vec<bool>,
+    /// (length - desired) / desired, signed fraction.
+    pub elongation_error: Vec<f64>,
+}
+
+impl TowlineCols {
+    fn push(&mut self, t_ns: i64, m: TowlineState) {
+        self.t_ns.push(t_ns);
+        self.length.push(m.length);
+        self.angle.push(m.angle);
+        self.tension.push(m.tension);
+        self.tension_cmd.push(m.tension_cmd);
+        self.slack.push(m.slack);
+        self.elongation_error.push(m.elongation_error);
+    }
+}
+
+/// Obstacles in long form: one row per active slot per message.
+#[derive(Debug, Default, Clone)]
+pub struct ObstacleCols {
+    /// Log time, ns.
+    pub t_ns: Vec<i64>,
+    /// Slot, 1-based.
+    pub slot: Vec<u32>,
+    /// Index into [`ObstacleCols::names`].
+    pub name_idx: Vec<u32>,
+    /// 1 circle, 2 ship ellipse.
+    pub kind: Vec<i32>,
+    /// North of the centre, m.
+    pub x: Vec<f64>,
+    /// East of the centre, m.
+    pub y: Vec<f64>,
+    /// Course, rad.
+    pub psi: Vec<f64>,
+    /// Speed, m/s.
+    pub speed: Vec<f64>,
+    /// Major axis or diameter, m.
+    pub length: Vec<f64>,
+    /// Minor axis or diameter, m.
+    pub width: Vec<f64>,
+    /// Distinct obstacle names (interned: a long log repeats them every step).
+    pub names: Vec<String>,
+}
+
+impl ObstacleCols {
+    fn push(&mut self, t_ns: i64, m: Obstacles) {
+        for o in m.obstacles {
+            let idx = intern(&mut self.names, o.name);
+            self.t_ns.push(t_ns);
+            self.slot.push(o.slot);
+            self.name_idx.push(idx);
+            self.kind.push(o.kind);
+            self.x.push(o.x);
+            self.y.push(o.y);
+            self.psi.push(o.psi);
+            self.speed.push(o.speed);
+            self.length.push(o.length);
+            self.width.push(o.width);
+        }
+    }
+
+    /// Name of row `i`.
+    pub fn name(&self, i: usize) -> &str {
+        self.name_idx
+            .get(i)
+            .and_then(|&k| self.names.get(k as usize))
+            .map_or("", String::as_str)
+    }
+}
+
+/// Plant inputs (`towing.PlantInputs`).
+#[derive(Debug, Default, Clone)]
+pub struct InputCols {
+    /// Log time, ns.
+    pub t_ns: Vec<i64>,
+    /// Aft tug surge, sway force (N) and yaw moment (N m).
+    pub tug1: [Vec<f64>; 3],
+    /// Forward tug surge, sway force (N) and yaw moment (N m).
+    pub tug2: [Vec<f64>; 3],
+    /// Commanded tensions, N.
+    pub tension_cmd: [Vec<f64>; 2],
+}
+
+impl InputCols {
+    fn push(&mut self, t_ns: i64, m: PlantInputs) {
+        self.t_ns.push(t_ns);
+        for k in 0..3 {
+            self.tug1[k].push(m.tug1[k]);
+            self.tug2[k].push(m.tug2[k]);
+        }
+        for k in 0..2 {
+            self.tension_cmd[k].push(m.tension_cmd[k]);
+        }
+    }
+}
+
+/// Guidance references (`towing.Reference`).
+#[derive(Debug, Default, Clone)]
+pub struct ReferenceCols {
+    /// Log time, ns.
+    pub t_ns: Vec<i64>,
+    /// Reference North, m.
+    pub x: Vec<f64>,
+    /// Reference East, m.
+    pub y: Vec<f64>,
+    /// Reference heading, rad.
+    pub psi: Vec<f64>,
+    /// Active waypoint, 1-based.
+    pub active_waypoint: Vec<u32>,
+    /// Altered waypoint in use.
+    pub altered: Vec<bool>,
+    /// Range-equivalent distance to the nearest obstacle, m.
+    pub d_ob: Vec<f64>,
+    /// Active waypoint as used: North, East (m), heading (rad).
+    pub waypoint: [Vec<f64>; 3],
+}
+
+impl ReferenceCols {
+    fn push(&mut self, t_ns: i64, m: Reference) {
+        self.t_ns.push(t_ns);
+        self.x.push(m.x);
+        self.y.push(m.y);
+        self.psi.push(m.psi);
+        self.active_waypoint.push(m.active_waypoint);
+        self.altered.push(m.altered);
+        self.d_ob.push(m.d_ob);
+        for k in 0..3 {
+            self.waypoint[k].push(m.waypoint[k]);
+        }
+    }
+}
+
+/// COLREGS encounters in long form: one row per slot per sample.
+#[derive(Debug, Default, Clone)]
+pub struct ColregsCols {
+    /// Log time, ns.
+    pub t_ns: Vec<i64>,
+    /// Slot, 1-based.
+    pub slot: Vec<u32>,
+    /// Index into [`ColregsCols::labels`] of the situation text.
+    pub situation_idx: Vec<u32>,
+    /// Index into [`ColregsCols::labels`] of the role text.
+    pub role_idx: Vec<u32>,
+    /// Situation code (-1 none, 0 safe, 1 head-on, 2 crossing give-way, 3 crossing
+    /// stand-on, 4 overtaking, 5 being overtaken, 6 unclassified).
+    pub situation_code: Vec<i32>,
+    /// Role code (0 none, 1 give-way, 2 stand-on).
+    pub role_code: Vec<i32>,
+    /// Distinct texts.
+    pub labels: Vec<String>,
+}
+
+impl ColregsCols {
+    fn push(&mut self, t_ns: i64, m: Colregs) {
+        for e in m.targets {
+            let s = intern(&mut self.labels, e.situation);
+            let r = intern(&mut self.labels, e.role);
+            self.t_ns.push(t_ns);
+            self.slot.push(e.slot);
+            self.situation_idx.push(s);
+            self.role_idx.push(r);
+            self.situation_code.push(e.situation_code);
+            self.role_code.push(e.role_code);
+        }
+    }
+
+    /// Text of label index `k`.
+    pub fn label(&self, k: u32) -> &str {
+        self.labels.get(k as usize).map_or("", String::as_str)
+    }
+}
+
+/// Commands (`towing.Command`).
+#[derive(Debug, Default, Clone)]
+pub struct CommandCols {
+    /// Log time, ns.
+    pub t_ns: Vec<i64>,
+    /// Aft tug thrust (surge N, sway N, yaw N m).
+    pub tug1: [Vec<f64>; 3],
+    /// Forward tug thrust (surge N, sway N, yaw N m).
+    pub tug2: [Vec<f64>; 3],
+    /// Commanded tensions, N.
+    pub tension: [Vec<f64>; 2],
+    /// Towing angles of the plan, rad.
+    pub desired_angle: [Vec<f64>; 2],
+}
+
+impl CommandCols {
+    fn push(&mut self, t_ns: i64, m: Command) {
+        self.t_ns.push(t_ns);
+        for k in 0..3 {
+            self.tug1[k].push(m.tug1[k]);
+            self.tug2[k].push(m.tug2[k]);
+        }
+        for k in 0..2 {
+            self.tension[k].push(m.tension[k]);
+            self.desired_angle[k].push(m.desired_angle[k]);
+        }
+    }
+}
+
+/// Solver reports (`towing.Solver`).
+#[derive(Debug, Default, Clone)]
+pub struct SolverCols {
+    /// Log time, ns.
+    pub t_ns: Vec<i64>,
+    /// Architecture code (1 distributed, 2 centralized).
+    pub architecture: Vec<i32>,
+    /// Avoidance scheme code (1 I, 2 II, 3 III).
+    pub scheme: Vec<i32>,
+    /// ADMM iterations (centralized: SCP loops).
+    pub iterations: Vec<u32>,
+    /// Stopping rule met.
+    pub converged: Vec<bool>,
+    /// Primal residuals of tug 1 and tug 2.
+    pub r_pri: [Vec<f64>; 2],
+    /// Dual residuals of tug 1 and tug 2.
+    pub r_dual: [Vec<f64>; 2],
+    /// Wall time of the sample, ms.
+    pub compute_time_ms: Vec<f64>,
+    /// Samples so far.
+    pub samples: Vec<u64>,
+    /// Fallbacks so far.
+    pub fallbacks: Vec<u64>,
+    /// Index into [`SolverCols::reasons`] of this sample's fallback reason, if any.
+    pub fallback_idx: Vec<Option<u32>>,
+    /// Distinct fallback reasons.
+    pub reasons: Vec<String>,
+}
+
+impl SolverCols {
+    fn push(&mut self, t_ns: i64, m: Solver) {
+        self.t_ns.push(t_ns);
+        self.architecture.push(m.architecture);
+        self.scheme.push(m.scheme);
+        self.iterations.push(m.iterations);
+        self.converged.push(m.converged);
+        for k in 0..2 {
+            self.r_pri[k].push(m.r_pri[k]);
+            self.r_dual[k].push(m.r_dual[k]);
+        }
+        self.compute_time_ms.push(m.compute_time_ms);
+        self.samples.push(m.samples);
+        self.fallbacks.push(m.fallbacks);
+        let idx = m.fallback.map(|r| intern(&mut self.reasons, r));
+        self.fallback_idx.push(idx);
+    }
+}
+
+/// A warning or error a unit logged (`foxglove.Log`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogLine {
+    /// Log time, ns.
+    pub t_ns: i64,
+    /// Foxglove level (3 warning, 4 error).
+    pub level: i32,
+    /// Unit name.
+    pub name: String,
+    /// The message.
+    pub message: String,
+}
+
+/// Everything kept from the plant topics.
+#[derive(Debug, Default, Clone)]
+pub struct PlantData {
+    /// `/plant/ship`.
+    pub ship: VesselCols,
+    /// `/plant/tug1` (aft).
+    pub tug1: VesselCols,
+    /// `/plant/tug2` (forward).
+    pub tug2: VesselCols,
+    /// `/plant/towline1`, `/plant/towline2`.
+    pub towlines: [TowlineCols; 2],
+    /// `/plant/obstacles`.
+    pub obstacles: ObstacleCols,
+    /// `/plant/inputs`.
+    pub inputs: InputCols,
+}
+
+/// Everything kept from the controller topics.
+#[derive(Debug, Default, Clone)]
+pub struct ControllerData {
+    /// `/controller/reference`.
+    pub reference: ReferenceCols,
+    /// `/controller/colregs`.
+    pub colregs: ColregsCols,
+    /// `/controller/command`.
+    pub command: CommandCols,
+    /// `/controller/solver`.
+    pub solver: SolverCols,
+}
+
+/// Count and first error of the messages of one topic that did not decode.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DecodeErrors {
+    /// Messages that failed.
+    pub count: u64,
+    /// The first failure.
+    pub first: String,
+}
+
+/// One log read into columns.
+#[derive(Debug, Clone)]
+pub struct LogFile {
+    /// The file.
+    pub path: PathBuf,
+    /// Which unit wrote it (from the `run` metadata's `unit`, else from the topics).
+    pub unit: Unit,
+    /// The `run` Metadata record (empty if absent).
+    pub metadata: BTreeMap<String, String>,
+    /// The `scenario.toml` attachment, if present.
+    pub scenario_text: Option<String>,
+    /// Messages read per topic (including the skipped topics).
+    pub message_counts: BTreeMap<String, u64>,
+    /// Messages that did not decode, per topic.
+    pub decode_errors: BTreeMap<String, DecodeErrors>,
+    /// Why the log ended early, if it did (the MCAP reader's error).
+    pub truncated: Option<String>,
+    /// Channels whose schema name differs from docs/logging.md (decoded anyway).
+    pub schema_mismatches: Vec<String>,
+    /// Size of the file, bytes.
+    pub bytes: u64,
+    /// Plant topics.
+    pub plant: PlantData,
+    /// Controller topics.
+    pub controller: ControllerData,
+    /// `/plant/log` and `/controller/log`.
+    pub logs: Vec<LogLine>,
+}
+
+impl LogFile {
+    /// True when the file holds the plant's vessel states.
+    pub fn has_plant(&self) -> bool {
+        !self.plant.ship.t_ns.is_empty()
+    }
+
+    /// True when the file holds any controller message.
+    pub fn has_controller(&self) -> bool {
+        !(self.controller.solver.t_ns.is_empty()
+            && self.controller.command.t_ns.is_empty()
+            && self.controller.reference.t_ns.is_empty())
+    }
+
+    /// Total messages decoded into columns.
+    fn decoded(&self) -> usize {
+        let p = &self.plant;
+        let c = &self.controller;
+        p.ship.t_ns.len()
+            + p.tug1.t_ns.len()
+            + p.tug2.t_ns.len()
+            + p.towlines[0].t_ns.len()
+            + p.towlines[1].t_ns.len()
+            + p.obstacles.t_ns.len()
+            + p.inputs.t_ns.len()
+            + c.reference.t_ns.len()
+            + c.colregs.t_ns.len()
+            + c.command.t_ns.len()
+            + c.solver.t_ns.len()
+    }
+}
+
+/// Topics the reader decodes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Topic {
+    Ship,
+    Tug1,
+    Tug2,
+    Towline1,
+    Towline2,
+    Obstacles,
+    Inputs,
+    PlantLog,
+    Reference,
+    Colregs,
+    Command,
+    Solver,
+    ControllerLog,
+    /// Known topic, not needed (scene, tf, prediction).
+    Skip,
+    /// Not in the contract.
+    Foreign,
+}
+
+fn classify(topic: &str) -> Topic {
+    match topic {
+        names::PLANT_SHIP => Topic::Ship,
+        names::PLANT_TUG1 => Topic::Tug1,
+        names::PLANT_TUG2 => Topic::Tug2,
+        names::PLANT_TOWLINE1 => Topic::Towline1,
+        names::PLANT_TOWLINE2 => Topic::Towline2,
+        names::PLANT_OBSTACLES => Topic::Obstacles,
+        names::PLANT_INPUTS => Topic::Inputs,
+        names::PLANT_LOG => Topic::PlantLog,
+        names::CONTROLLER_REFERENCE => Topic::Reference,
+        names::CONTROLLER_COLREGS => Topic::Colregs,
+        names::CONTROLLER_COMMAND => Topic::Command,
+        names::CONTROLLER_SOLVER => Topic::Solver,
+        names::CONTROLLER_LOG => Topic::ControllerLog,
+        names::TF | names::PLANT_SCENE | names::CONTROLLER_SCENE | names::CONTROLLER_PREDICTION => {
+            Topic::Skip
+        }
+        _ => Topic::Foreign,
+    }
+}
+
+/// Counts the bytes pulled from the file, for the progress bar.
+struct Counting<R> {
+    inner: R,
+    progress: indicatif::ProgressBar,
+}
+
+impl<R: Read> Read for Counting<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.progress.inc(n as u64);
+        Ok(n)
+    }
+}
+
+struct ChannelInfo {
+    topic: String,
+    kind: Topic,
+    json: bool,
+}
+
+/// Reads one log. `progress` is advanced by the bytes read (pass
+/// `ProgressBar::hidden()` for none).
+///
+/// # Errors
+/// The file is missing or unreadable, not MCAP, has none of the expected topics, or not one
+/// message could be used. A log that ends early is not an error (see
+/// [`LogFile::truncated`]).
+pub fn read_log(path: &Path, progress: &indicatif::ProgressBar) -> Result<LogFile> {
+    let io_err = |source| AnalyzerError::Io {
+        path: path.to_owned(),
+        source,
+    };
+    let file = File::open(path).map_err(io_err)?;
+    let bytes = file.metadata().map_err(io_err)?.len();
+    if bytes == 0 {
+        return Err(AnalyzerError::Empty {
+            path: path.to_owned(),
+        });
+    }
+    progress.set_length(bytes);
+    progress.set_position(0);
+    let mut source = BufReader::with_capacity(
+        1 << 20,
+        Counting {
+            inner: file,
+            progress: progress.clone(),
+        },
+    );
+
+    let mut log = LogFile {
+        path: path.to_owned(),
+        unit: Unit::Plant,
+        metadata: BTreeMap::new(),
+        scenario_text: None,
+        message_counts: BTreeMap::new(),
+        decode_errors: BTreeMap::new(),
+        truncated: None,
+        schema_mismatches: Vec::new(),
+        bytes,
+        plant: PlantData::default(),
+        controller: ControllerData::default(),
+        logs: Vec::new(),
+    };
+    let mut channels: BTreeMap<u16, ChannelInfo> = BTreeMap::new();
+    let mut schema_names: BTreeMap<u16, String> = BTreeMap::new();
+    let mut reader = LinearReader::new();
+    let mut past_data_end = false;
+    let mut records = 0u64;
+
+    while let Some(event) = reader.next_event() {
+        let event = match event {
+            Ok(event) => event,
+            Err(err) => {
+                stop_at_error(&mut log, err, records, bytes)?;
+                break;
+            }
+        };
+        match event {
+            LinearReadEvent::ReadRequest(need) => {
+                let read = loop {
+                    match source.read(reader.insert(need)) {
+                        Ok(n) => break n,
+                        Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                        Err(e) => return Err(io_err(e)),
+                    }
+                };
+                reader.notify_read(read);
+            }
+            LinearReadEvent::Record { opcode, data } => {
+                records += 1;
+                if opcode == mcap::records::op::DATA_END {
+                    past_data_end = true;
+                    continue;
+                }
+                if past_data_end {
+                    // The summary repeats schemas and channels; nothing new there.
+                    continue;
+                }
+                let record = match mcap::parse_record(opcode, data) {
+                    Ok(record) => record,
+                    Err(err) => {
+                        stop_at_error(&mut log, err, records, bytes)?;
+                        break;
+                    }
+                };
+                match record {
+                    Record::Schema { header, .. } => {
+                        schema_names.insert(header.id, header.name);
+                    }
+                    Record::Channel(ch) => {
+                        let kind = classify(&ch.topic);
+                        let json = ch.message_encoding == topics::MESSAGE_ENCODING;
+                        if let (Some(expected), Some(found)) =
+                            (expected_schema(kind), schema_names.get(&ch.schema_id))
+                        {
+                            if expected != found {
+                                log.schema_mismatches.push(format!(
+                                    "{}: schema `{found}`, docs/logging.md says `{expected}`",
+                                    ch.topic
+                                ));
+                            }
+                        }
+                        channels.insert(
+                            ch.id,
+                            ChannelInfo {
+                                topic: ch.topic,
+                                kind,
+                                json,
+                            },
+                        );
+                    }
+                    Record::Message { header, data } => {
+                        let Some(channel) = channels.get(&header.channel_id) else {
+                            continue;
+                        };
+                        *log.message_counts.entry(channel.topic.clone()).or_insert(0) += 1;
+                        if !channel.json {
+                            if matches!(channel.kind, Topic::Skip | Topic::Foreign) {
+                                continue;
+                            }
+                            note_decode_error(
+                                &mut log,
+                                &channel.topic,
+                                "message encoding is not json".to_owned(),
+                            );
+                            continue;
+                        }
+                        let t_ns = i64::try_from(header.log_time).unwrap_or(i64::MAX);
+                        decode_into(&mut log, channel, t_ns, &data);
+                    }
+                    Record::Metadata(m) if m.name == topics::METADATA_RUN => {
+                        log.metadata = m.metadata;
+                    }
+                    Record::Attachment { header, data, .. }
+                        if header.name == topics::SCENARIO_ATTACHMENT =>
+                    {
+                        log.scenario_text = Some(String::from_utf8_lossy(&data).into_owned());
+                    }
+                    _ => {}
+                }
+            }
+        }
+    }
+    progress.set_position(bytes);
+    finish(log, &channels)
+}
+
+/// Turns the reader's error into "not MCAP" (nothing read yet) or a truncation mark.
+fn stop_at_error(log: &mut LogFile, err: McapError, records: u64, bytes: u64) -> Result<()> {
+    match err {
+        McapError::BadMagic if records == 0 => Err(AnalyzerError::NotMcap {
+            path: log.path.clone(),
+        }),
+        McapError::UnexpectedEof if records == 0 && bytes < 8 => Err(AnalyzerError::NotMcap {
+            path: log.path.clone(),
+        }),
+        err if records == 0 => Err(AnalyzerError::Unreadable {
+            path: log.path.clone(),
+            reason: err.to_string(),
+        }),
+        err => {
+            log.truncated = Some(match err {
+                McapError::UnexpectedEof => {
+                    "the log ends in the middle of a record (truncated)".to_owned()
+                }
+                other => format!("the log is broken after {records} records: {other}"),
+            });
+            Ok(())
+        }
+    }
+}
+
+fn note_decode_error(log: &mut LogFile, topic: &str, err: String) {
+    log.decode_errors
+        .entry(topic.to_owned())
+        .and_modify(|e| e.count += 1)
+        .or_insert(DecodeErrors {
+            count: 1,
+            first: err,
+        });
+}
+
+fn decode<T: DeserializeOwned>(log: &mut LogFile, topic: &str, data: &[u8]) -> Option<T> {
+    match serde_json::from_slice::<T>(data) {
+        Ok(m) => Some(m),
+        Err(e) => {
+            note_decode_error(log, topic, e.to_string());
+            None
+        }
+    }
+}
+
+fn decode_into(log: &mut LogFile, channel: &ChannelInfo, t_ns: i64, data: &[u8]) {
+    let topic = channel.topic.as_str();
+    match channel.kind {
+        Topic::Ship => {
+            if let Some(m) = decode::<VesselState>(log, topic, data) {
+                log.plant.ship.push(t_ns, m);
+            }
+        }
+        Topic::Tug1 => {
+            if let Some(m) = decode::<VesselState>(log, topic, data) {
+                log.plant.tug1.push(t_ns, m);
+            }
+        }
+        Topic::Tug2 => {
+            if let Some(m) = decode::<VesselState>(log, topic, data) {
+                log.plant.tug2.push(t_ns, m);
+            }
+        }
+        Topic::Towline1 => {
+            if let Some(m) = decode::<TowlineState>(log, topic, data) {
+                log.plant.towlines[0].push(t_ns, m);
+            }
+        }
+        Topic::Towline2 => {
+            if let Some(m) = decode::<TowlineState>(log, topic, data) {
+                log.plant.towlines[1].push(t_ns, m);
+            }
+        }
+        Topic::Obstacles => {
+            if let Some(m) = decode::<Obstacles>(log, topic, data) {
+                log.plant.obstacles.push(t_ns, m);
+            }
+        }
+        Topic::Inputs => {
+            if let Some(m) = decode::<PlantInputs>(log, topic, data) {
+                log.plant.inputs.push(t_ns, m);
+            }
+        }
+        Topic::Reference => {
+            if let Some(m) = decode::<Reference>(log, topic, data) {
+                log.controller.reference.push(t_ns, m);
+            }
+        }
+        Topic::Colregs => {
+            if let Some(m) = decode::<Colregs>(log, topic, data) {
+                log.controller.colregs.push(t_ns, m);
+            }
+        }
+        Topic::Command => {
+            if let Some(m) = decode::<Command>(log, topic, data) {
+                log.controller.command.push(t_ns, m);
+            }
+        }
+        Topic::Solver => {
+            if let Some(m) = decode::<Solver>(log, topic, data) {
+                log.controller.solver.push(t_ns, m);
+            }
+        }
+        Topic::PlantLog | Topic::ControllerLog => {
+            if let Some(m) = decode::<Log>(log, topic, data) {
+                log.logs.push(LogLine {
+                    t_ns,
+                    level: m.level,
+                    name: m.name,
+                    message: m.message,
+                });
+            }
+        }
+        Topic::Skip | Topic::Foreign => {}
+    }
+}
+
+/// Decides the unit and refuses files with nothing useful.
+fn finish(mut log: LogFile, channels: &BTreeMap<u16, ChannelInfo>) -> Result<LogFile> {
+    let plant_topics = channels
+        .values()
+        .any(|c| c.topic.starts_with("/plant/") && c.kind != Topic::Foreign);
+    let controller_topics = channels
+        .values()
+        .any(|c| c.topic.starts_with("/controller/") && c.kind != Topic::Foreign);
+    let by_metadata = match log.metadata.get(metadata_keys::UNIT).map(String::as_str) {
+        Some("TowingPlant") => Some(Unit::Plant),
+        Some("TowingController") => Some(Unit::Controller),
+        _ => None,
+    };
+    log.unit = match (by_metadata, plant_topics, controller_topics) {
+        (_, true, true) => Unit::Both,
+        (Some(unit), _, _) => unit,
+        (None, true, false) => Unit::Plant,
+        (None, false, true) => Unit::Controller,
+        (None, false, false) => {
+            let mut topics: Vec<&str> = channels.values().map(|c| c.topic.as_str()).collect();
+            topics.sort_unstable();
+            topics.dedup();
+            let found = if topics.is_empty() {
+                if let Some(reason) = &log.truncated {
+                    return Err(AnalyzerError::TruncatedEmpty {
+                        path: log.path.clone(),
+                        reason: format!("it ends before its first channel ({reason})"),
+                    });
+                }
+                "; no channels at all".to_owned()
+            } else {
+                format!("; found: {}", topics.join(", "))
+            };
+            return Err(AnalyzerError::NoExpectedTopics {
+                path: log.path.clone(),
+                found,
+            });
+        }
+    };
+    if log.decoded() == 0 {
+        let reason = if let Some((topic, e)) = log.decode_errors.iter().next() {
+            format!(
+                "{} messages of {topic} do not match docs/logging.md: {}",
+                e.count, e.first
+            )
+        } else if let Some(reason) = &log.truncated {
+            return Err(AnalyzerError::TruncatedEmpty {
+                path: log.path.clone(),
+                reason: format!("it ends before its first message ({reason})"),
+            });
+        } else {
+            "the log has the channels but no messages".to_owned()
+        };
+        return Err(AnalyzerError::NoUsableData {
+            path: log.path.clone(),
+            reason,
+        });
+    }
+    Ok(log)
+}
+
+/// Index of `name` in `names`, appended if new. The lists are short (obstacle names,
+/// situation labels); fallback reasons can be many, so the search runs from the end, where
+/// a repeated reason usually is.
+fn intern(names: &mut Vec<String>, name: String) -> u32 {
+    if let Some(k) = names.iter().rposition(|n| *n == name) {
+        return u32::try_from(k).unwrap_or(u32::MAX);
+    }
+    names.push(name);
+    u32::try_from(names.len() - 1).unwrap_or(u32::MAX)
+}
+
+/// The schema name docs/logging.md gives a decoded topic.
+fn expected_schema(kind: Topic) -> Option<&'static str> {
+    use towing_log::TopicMessage;
+    Some(match kind {
+        Topic::Ship | Topic::Tug1 | Topic::Tug2 => VesselState::SCHEMA_NAME,
+        Topic::Towline1 | Topic::Towline2 => TowlineState::SCHEMA_NAME,
+        Topic::Obstacles => Obstacles::SCHEMA_NAME,
+        Topic::Inputs => PlantInputs::SCHEMA_NAME,
+        Topic::Reference => Reference::SCHEMA_NAME,
+        Topic::Colregs => Colregs::SCHEMA_NAME,
+        Topic::Command => Command::SCHEMA_NAME,
+        Topic::Solver => Solver::SCHEMA_NAME,
+        Topic::PlantLog | Topic::ControllerLog => Log::SCHEMA_NAME,
+        Topic::Skip | Topic::Foreign => return None,
+    })
+}

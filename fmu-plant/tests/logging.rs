@@ -1,0 +1,261 @@
+//! TowingPlant's MCAP log (docs/logging.md) through the exported FMI functions: what the
+//! file holds after a run, errors at creation, closing at terminate or at free, and FMU
+//! states that go back in time.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
+
+use fmi2_slave::ffi::Fmi2Status;
+use fmi2_slave::testing::{Exports, Fmu};
+use std::collections::HashMap;
+use std::path::Path;
+use towing_interface::testing;
+use towing_log::topics::{self, names, *};
+use towing_plant::variables::{self as vars, DESCRIPTION};
+
+fn exports() -> Exports {
+    fmi2_slave::exports_of!(towing_plant)
+}
+
+fn plant_logging_to(name: &str, path: &Path) -> Fmu {
+    let fmu = testing::instantiate(exports(), &DESCRIPTION, name);
+    assert_eq!(
+        fmu.set_string(vars::LOG_FILE, path.to_str().unwrap()),
+        Fmi2Status::Ok
+    );
+    fmu
+}
+
+fn pull(fmu: &Fmu) {
+    assert_eq!(fmu.set_real(vars::tug_force(1, 0), 3.0), Fmi2Status::Ok);
+    assert_eq!(fmu.set_real(vars::tension_cmd(1), 2.0), Fmi2Status::Ok);
+}
+
+fn steps(fmu: &Fmu, t0: f64, n: usize) -> f64 {
+    let mut t = t0;
+    for _ in 0..n {
+        assert_eq!(fmu.step(t, 0.1), Fmi2Status::Ok, "{}", fmu.log_text());
+        t += 0.1;
+    }
+    t
+}
+
+/// Messages per topic, checking that times never decrease and every message decodes.
+/// Messages by topic: (log time ns, JSON payload).
+type ByTopic = HashMap<String, Vec<(u64, Vec<u8>)>>;
+
+fn read_messages(bytes: &[u8]) -> (ByTopic, u64) {
+    let mut by_topic = ByTopic::new();
+    let mut last = 0;
+    for m in mcap::MessageStream::new(bytes).unwrap() {
+        let m = m.unwrap();
+        assert!(m.log_time >= last, "log times must not decrease");
+        last = m.log_time;
+        by_topic
+            .entry(m.channel.topic.clone())
+            .or_default()
+            .push((m.log_time, m.data.to_vec()));
+    }
+    (by_topic, last)
+}
+
+#[test]
+fn a_run_logs_every_topic_once_at_the_start_and_after_each_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("plant.mcap");
+    let fmu = plant_logging_to("log", &path);
+    fmu.init(0.0, None);
+    assert_eq!(fmu.get_string(vars::LOG_FILE), path.to_str().unwrap());
+    pull(&fmu);
+    let n = 50;
+    steps(&fmu, 0.0, n);
+    assert_eq!(fmu.terminate(), Fmi2Status::Ok, "{}", fmu.log_text());
+
+    let bytes = std::fs::read(&path).unwrap();
+    let (msgs, last) = read_messages(&bytes);
+    assert_eq!(last, 5_000_000_000);
+    for (topic, _) in topics::PLANT_TOPICS {
+        let expected = match topic {
+            names::PLANT_LOG => 0,
+            names::PLANT_SCENE_STATIC => 1,
+            _ => n + 1,
+        };
+        assert_eq!(msgs.get(topic).map_or(0, Vec::len), expected, "{topic}");
+    }
+    // Contents: the ship where the plant says it is, the inputs used, the obstacles.
+    let ship: Vec<VesselState> = msgs[names::PLANT_SHIP]
+        .iter()
+        .map(|(_, d)| serde_json::from_slice(d).unwrap())
+        .collect();
+    assert_eq!((ship[0].t, ship[0].x, ship[0].y), (0.0, -4.9, 7.0));
+    assert_eq!(ship[n].x, fmu.get_real(vars::vessel_state(0, 0)));
+    assert!((ship[n].t - 5.0).abs() < 1e-12);
+    let inputs: PlantInputs = serde_json::from_slice(&msgs[names::PLANT_INPUTS][n].1).unwrap();
+    assert_eq!(inputs.tug2[0], 3.0);
+    assert_eq!(inputs.tension_cmd, [0.0, 2.0]);
+    let line: TowlineState = serde_json::from_slice(&msgs[names::PLANT_TOWLINE2][n].1).unwrap();
+    assert_eq!(line.length, fmu.get_real(vars::towline(1, 0)));
+    assert!((line.elongation_error - (line.length - 1.0)).abs() < 1e-12);
+    assert_eq!(line.tension_cmd, 2.0);
+    let obstacles: Obstacles = serde_json::from_slice(&msgs[names::PLANT_OBSTACLES][n].1).unwrap();
+    // Active slots only, as the plant's `obstacle[k].kind` outputs.
+    let active: Vec<u32> = (0..8)
+        .filter(|&k| fmu.get_integer(vars::obstacle(k, vars::OBSTACLE_KIND)) != 0)
+        .map(|k| k + 1)
+        .collect();
+    let logged: Vec<u32> = obstacles.obstacles.iter().map(|o| o.slot).collect();
+    assert_eq!(logged, active);
+    assert_eq!(obstacles.obstacles[0].name, "a");
+    assert_eq!(obstacles.obstacles[0].kind, 1);
+    let tf: FrameTransforms = serde_json::from_slice(&msgs[names::TF][0].1).unwrap();
+    let children: Vec<_> = tf
+        .transforms
+        .iter()
+        .map(|t| t.child_frame_id.as_str())
+        .collect();
+    assert_eq!(children, ["ship", "tug1", "tug2"]);
+    assert_eq!(
+        (
+            tf.transforms[0].translation.x,
+            tf.transforms[0].translation.y
+        ),
+        (7.0, -4.9)
+    );
+    let scene: SceneUpdate = serde_json::from_slice(&msgs[names::PLANT_SCENE][1].1).unwrap();
+    assert_eq!(scene.entities[0].id, "towlines");
+    assert_eq!(scene.entities[0].lines.len(), 2);
+    assert_eq!(scene.entities[0].timestamp.nsec, 100_000_000);
+    let fixed: SceneUpdate = serde_json::from_slice(&msgs[names::PLANT_SCENE_STATIC][0].1).unwrap();
+    let ids: Vec<_> = fixed.entities.iter().map(|e| e.id.as_str()).collect();
+    assert_eq!(
+        ids,
+        ["route", "hazards", "ship_hull", "tug1_hull", "tug2_hull"]
+    );
+    assert_eq!(fixed.entities[1].cylinders.len(), 3);
+    assert_eq!(fixed.entities[2].frame_id, "ship");
+    assert!(fixed.entities[2].frame_locked);
+    assert_eq!(fixed.entities[2].cubes[0].size.x, 1.255);
+
+    // Records besides messages.
+    let summary = mcap::Summary::read(&bytes)
+        .unwrap()
+        .expect("a finished file");
+    let run = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).unwrap();
+    assert_eq!(run.name, topics::METADATA_RUN);
+    assert_eq!(run.metadata["unit"], "TowingPlant");
+    assert_eq!(run.metadata["guid"], DESCRIPTION.guid());
+    assert_eq!(run.metadata["scenario"], topics::BUNDLED_SCENARIO_LABEL);
+    assert_eq!(run.metadata["scenario_name"], "paper");
+    assert_eq!(run.metadata["start_time"], "0");
+    let params: serde_json::Value = serde_json::from_str(&run.metadata["parameters"]).unwrap();
+    assert_eq!(params["log_file"], path.to_str().unwrap());
+    assert_eq!(params["hull_model"], 0);
+    let att = mcap::read::attachment(&bytes, &summary.attachment_indexes[0]).unwrap();
+    assert_eq!(att.name, "scenario.toml");
+    assert_eq!(
+        String::from_utf8(att.data.to_vec()).unwrap(),
+        testing::read_repository_file("scenarios/paper.toml")
+    );
+}
+
+#[test]
+fn without_a_log_file_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let fmu = testing::instantiate(exports(), &DESCRIPTION, "nolog");
+    fmu.init(0.0, None);
+    assert_eq!(fmu.get_string(vars::LOG_FILE), "");
+    steps(&fmu, 0.0, 3);
+    assert_eq!(fmu.terminate(), Fmi2Status::Ok);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+#[test]
+fn a_log_file_that_cannot_be_created_is_an_error_naming_it() {
+    let fmu = plant_logging_to("bad", Path::new("/nonexistent-dir/plant.mcap"));
+    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
+    assert_eq!(fmu.enter_init(), Fmi2Status::Ok);
+    assert_eq!(fmu.exit_init(), Fmi2Status::Error);
+    let text = fmu.last_text();
+    assert!(
+        text.contains("log_file")
+            && text.contains("/nonexistent-dir/plant.mcap")
+            && text.contains("No such file"),
+        "{text}"
+    );
+}
+
+#[test]
+fn free_instance_finishes_a_log_that_terminate_did_not() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("freed.mcap");
+    {
+        let fmu = plant_logging_to("freed", &path);
+        fmu.init(0.0, None);
+        steps(&fmu, 0.0, 20);
+        // Dropped without fmi2Terminate: fmi2FreeInstance closes the file.
+    }
+    let bytes = std::fs::read(&path).unwrap();
+    let summary = mcap::Summary::read(&bytes)
+        .unwrap()
+        .expect("a finished file");
+    assert_eq!(summary.stats.unwrap().channel_message_counts.len(), 10);
+    let (msgs, _) = read_messages(&bytes);
+    assert_eq!(msgs[names::PLANT_SHIP].len(), 21);
+}
+
+#[test]
+fn a_start_time_other_than_zero_is_the_time_of_the_first_messages() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("late.mcap");
+    let fmu = plant_logging_to("late", &path);
+    fmu.init(100.0, None);
+    steps(&fmu, 100.0, 2);
+    assert_eq!(fmu.terminate(), Fmi2Status::Ok);
+    let bytes = std::fs::read(&path).unwrap();
+    let (msgs, last) = read_messages(&bytes);
+    assert_eq!(msgs[names::PLANT_SHIP][0].0, 100_000_000_000);
+    assert_eq!(last, 100_200_000_000);
+}
+
+#[test]
+fn going_back_to_an_earlier_fmu_state_keeps_log_times_non_decreasing() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("rollback.mcap");
+    let fmu = plant_logging_to("rollback", &path);
+    fmu.init(0.0, None);
+    pull(&fmu);
+    let t = steps(&fmu, 0.0, 10);
+    let saved = fmu.get_state();
+    let end = steps(&fmu, t, 10);
+    // SAFETY: `saved` is a live state of this instance, freed once below.
+    assert_eq!(unsafe { fmu.set_state(saved) }, Fmi2Status::Ok);
+    unsafe { fmu.free_state(saved) };
+    // Redo the last 10 steps and go 5 further: the repeated times are dropped from the
+    // log (times must not decrease), the new ones are written; no warning.
+    steps(&fmu, t, 15);
+    assert_eq!(fmu.terminate(), Fmi2Status::Ok, "{}", fmu.log_text());
+    let bytes = std::fs::read(&path).unwrap();
+    let (msgs, last) = read_messages(&bytes);
+    assert_eq!(last, ((end + 0.5) * 1e9).round() as u64);
+    // 0..=2.0 s first, then 2.1..=2.5 s after the replay (2.0 s itself is written again:
+    // equal times are allowed).
+    let ship = &msgs[names::PLANT_SHIP];
+    assert_eq!(ship.len(), 21 + 1 + 5);
+}
+
+#[test]
+fn a_log_that_cannot_be_written_is_an_error_at_exit_initialization() {
+    // /dev/full takes the open and refuses every write (ENOSPC). (A failure during the
+    // run, a warning and then fmi2Error at terminate, is tested on `SharedLog` in
+    // towing-log.)
+    if !Path::new("/dev/full").exists() {
+        return;
+    }
+    let fmu = plant_logging_to("full", Path::new("/dev/full"));
+    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
+    assert_eq!(fmu.enter_init(), Fmi2Status::Ok);
+    assert_eq!(fmu.exit_init(), Fmi2Status::Error);
+    let text = fmu.last_text();
+    assert!(
+        text.contains("`log_file`") && text.contains("/dev/full") && text.contains("No space left"),
+        "{text}"
+    );
+}
