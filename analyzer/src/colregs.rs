@@ -101,62 +101,9 @@ pub struct EncounterSample {
     pub tow_range: f64,
 }
 
-/// The COLREGS situation (codes as the controller FMU's `colregs[k].situation`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Situation {
-    /// Not closing.
-    Safe,
-    /// Rule 14.
-    HeadOn,
-    /// Rule 15/16, target on own starboard side.
-    CrossingGiveWay,
-    /// Rule 15/17, target on own port side.
-    CrossingStandOn,
-    /// Rule 13, own ship overtaking.
-    Overtaking,
-    /// Rule 13/17, own ship being overtaken.
-    BeingOvertaken,
-    /// Closing, no sector.
-    Unclassified,
-}
-
-impl Situation {
-    /// From the controller's code (-1 none and unknown codes: `None`).
-    #[must_use]
-    pub fn from_code(code: i32) -> Option<Self> {
-        Some(match code {
-            0 => Situation::Safe,
-            1 => Situation::HeadOn,
-            2 => Situation::CrossingGiveWay,
-            3 => Situation::CrossingStandOn,
-            4 => Situation::Overtaking,
-            5 => Situation::BeingOvertaken,
-            6 => Situation::Unclassified,
-            _ => return None,
-        })
-    }
-
-    /// Text as in the controller log.
-    #[must_use]
-    pub fn label(self) -> &'static str {
-        match self {
-            Situation::Safe => "safe",
-            Situation::HeadOn => "head-on",
-            Situation::CrossingGiveWay => "crossing give-way",
-            Situation::CrossingStandOn => "crossing stand-on",
-            Situation::Overtaking => "overtaking",
-            Situation::BeingOvertaken => "being overtaken",
-            Situation::Unclassified => "unclassified",
-        }
-    }
-
-    /// True for a situation a rule applies to (not safe).
-    #[must_use]
-    pub fn definite(self) -> bool {
-        !matches!(self, Situation::Safe)
-    }
-}
+/// The COLREGS situation: the guidance's (codes as the controller FMU's
+/// `colregs[k].situation`, text as in the controller log).
+pub use towing_guidance::Situation;
 
 /// Woerner-style classification (`docs/colregs.md` section 3, default preset) from the
 /// bearing `beta`, contact angle `alpha` (deg) and the speeds.
@@ -411,10 +358,10 @@ pub fn assess(
     if let Some(c) = controller {
         for (k, &code) in c.situation_codes.iter().enumerate() {
             if let Some(s) = Situation::from_code(code) {
-                if reported.last().map(String::as_str) != Some(s.label()) {
-                    reported.push(s.label().to_owned());
+                if reported.last().map(String::as_str) != Some(s.name()) {
+                    reported.push(s.name().to_owned());
                 }
-                if situation.is_none() && s.definite() {
+                if situation.is_none() && s != Situation::Safe {
                     situation = Some(s);
                     role = c.roles.get(k).cloned();
                 }
@@ -440,11 +387,11 @@ pub fn assess(
     let mut report = EncounterReport {
         target: target.to_owned(),
         slot,
-        situation: situation.map(|s| s.label().to_owned()),
+        situation: situation.map(|s| s.name().to_owned()),
         role,
         situations_reported: reported,
-        situation_geometric: geometric.map(|s| s.label().to_owned()),
-        situation_assessed: assessed.map(|s| s.label().to_owned()),
+        situation_geometric: geometric.map(|s| s.name().to_owned()),
+        situation_assessed: assessed.map(|s| s.name().to_owned()),
         t_detect_s: None,
         t_detect_tow_s: None,
         t_first_action_s: None,

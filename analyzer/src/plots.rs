@@ -353,39 +353,52 @@ fn states_panels(d: &PlotData<'_>) -> Vec<Panel> {
     ]
 }
 
+/// The actual (plant, not for rates) and commanded lines of one towing channel of
+/// `line`, its values (or their rates) taken from a series by `values`.
+fn towing_lines(
+    d: &PlotData<'_>,
+    line: usize,
+    rate: bool,
+    values: impl Fn(&TowingSeries<'_>) -> Vec<f64>,
+) -> Vec<Line> {
+    let series = |s: &TowingSeries<'_>, label: &str, color: RGBColor, width: u32| -> Line {
+        let v = values(s);
+        let v = if rate { rates(&s.t, &v) } else { v };
+        Line {
+            label: label.to_owned(),
+            pts: decimate(&s.t, &v),
+            color,
+            width,
+            dash: Dash::Solid,
+        }
+    };
+    let mut lines = Vec::new();
+    if !rate {
+        lines.push(series(
+            &d.actual,
+            "actual (plant)",
+            RGBColor(150, 150, 150),
+            1,
+        ));
+    }
+    if let Some(c) = d.command.as_ref() {
+        lines.push(series(
+            c,
+            "commanded",
+            if line == 0 { TUG1 } else { TUG2 },
+            2,
+        ));
+    }
+    lines
+}
+
 fn towing_panels(d: &PlotData<'_>, rate: bool) -> Vec<Panel> {
     let b = &d.bounds;
     let mut panels = Vec::new();
-    let commanded = d.command.as_ref();
     for line in 0..2 {
-        let mut lines = Vec::new();
-        let series = |s: &TowingSeries<'_>, label: &str, color: RGBColor, width: u32| -> Line {
-            let v: Vec<f64> = s.angle[line].iter().map(|a| a.to_degrees()).collect();
-            let v = if rate { rates(&s.t, &v) } else { v };
-            Line {
-                label: label.to_owned(),
-                pts: decimate(&s.t, &v),
-                color,
-                width,
-                dash: Dash::Solid,
-            }
-        };
-        if !rate {
-            lines.push(series(
-                &d.actual,
-                "actual (plant)",
-                RGBColor(150, 150, 150),
-                1,
-            ));
-        }
-        if let Some(c) = commanded {
-            lines.push(series(
-                c,
-                "commanded",
-                if line == 0 { TUG1 } else { TUG2 },
-                2,
-            ));
-        }
+        let lines = towing_lines(d, line, rate, |s| {
+            s.angle[line].iter().map(|a| a.to_degrees()).collect()
+        });
         let (lim, unit) = if rate {
             (b.angle_rate_rad_per_s.to_degrees(), "deg/s")
         } else {
@@ -410,34 +423,7 @@ fn towing_panels(d: &PlotData<'_>, rate: bool) -> Vec<Panel> {
         });
     }
     for line in 0..2 {
-        let mut lines = Vec::new();
-        let series = |s: &TowingSeries<'_>, label: &str, color: RGBColor, width: u32| -> Line {
-            let v = &s.tension[line];
-            let v = if rate { rates(&s.t, v) } else { v.to_vec() };
-            Line {
-                label: label.to_owned(),
-                pts: decimate(&s.t, &v),
-                color,
-                width,
-                dash: Dash::Solid,
-            }
-        };
-        if !rate {
-            lines.push(series(
-                &d.actual,
-                "actual (plant)",
-                RGBColor(150, 150, 150),
-                1,
-            ));
-        }
-        if let Some(c) = commanded {
-            lines.push(series(
-                c,
-                "commanded",
-                if line == 0 { TUG1 } else { TUG2 },
-                2,
-            ));
-        }
+        let lines = towing_lines(d, line, rate, |s| s.tension[line].to_vec());
         let bounds = if rate {
             let r = b.tension_rate_n_per_s;
             vec![(r, format!("+{r} N/s")), (-r, format!("-{r} N/s"))]

@@ -485,7 +485,7 @@ impl SynthRun {
                     targets.push(Encounter {
                         slot: ob.slot,
                         situation: Situation::from_code(code)
-                            .map_or("none", Situation::label)
+                            .map_or("none", Situation::name)
                             .to_owned(),
                         role: role.to_owned(),
                         situation_code: code,
@@ -550,15 +550,7 @@ impl SynthRun {
 }
 
 fn situation_code(s: Option<Situation>) -> i32 {
-    match s {
-        Some(Situation::Safe) | None => 0,
-        Some(Situation::HeadOn) => 1,
-        Some(Situation::CrossingGiveWay) => 2,
-        Some(Situation::CrossingStandOn) => 3,
-        Some(Situation::Overtaking) => 4,
-        Some(Situation::BeingOvertaken) => 5,
-        Some(Situation::Unclassified) => 6,
-    }
+    s.map_or(0, Situation::code)
 }
 
 /// A synthetic run could not be written.

@@ -31,7 +31,7 @@ use towing_control::{
     Architecture, AvoidanceScheme, Command, Controller, ControllerConfig, Measurement, SampleReport,
 };
 use towing_interface::ScenarioFile;
-use towing_log::{LogOptions, LogWriter, RunInfo, SharedLog};
+use towing_log::{LogOptions, RunInfo, SharedLog};
 use towing_model::{HullModel, Scenario, MAX_OBSTACLES};
 use towing_mpc::HORIZON;
 
@@ -361,8 +361,6 @@ impl ControllerFmu {
         if self.params.log_file.is_empty() {
             return Ok(());
         }
-        let mut writer = LogWriter::create(&self.params.log_file, LogOptions::default())
-            .map_err(|e| format!("parameter `log_file`: {e}"))?;
         let guid = vars::DESCRIPTION.guid();
         let p = &self.params;
         let mut parameters = serde_json::Map::new();
@@ -390,15 +388,13 @@ impl ControllerFmu {
             parameters: serde_json::Value::Object(parameters),
             scenario_text: &self.scenario_text,
         };
-        let written = writer
-            .write_run(&info)
-            .and_then(|()| logging::register_topics(&mut writer));
-        if let Err(e) = written {
-            let _ = writer.finish();
-            return Err(format!("parameter `log_file`: {e}"));
-        }
-        // From here on the messages are serialized and written on the log's own thread.
-        self.log = SharedLog::spawn(writer).map_err(|e| format!("parameter `log_file`: {e}"))?;
+        self.log = SharedLog::open(
+            &p.log_file,
+            LogOptions::default(),
+            &info,
+            logging::register_topics,
+        )
+        .map_err(|e| format!("parameter `log_file`: {e}"))?;
         log.info(
             "logEvents",
             &format!("MCAP log {} created", self.params.log_file),

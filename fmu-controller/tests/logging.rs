@@ -7,10 +7,10 @@ mod support;
 
 use fmi2_slave::ffi::Fmi2Status;
 use fmi2_slave::testing::Fmu;
-use std::collections::HashMap;
 use std::path::Path;
 use support::*;
 use towing_controller::variables::{self as vars, DESCRIPTION};
+use towing_interface::testing::{assert_uncreatable_log_file_is_named, read_log_messages};
 use towing_log::topics::{self, names, *};
 
 fn logging_to(name: &str, path: &Path) -> Fmu {
@@ -37,24 +37,6 @@ fn steps(fmu: &Fmu, t0: f64, h: f64, n: usize) -> f64 {
     t
 }
 
-/// Messages by topic: (log time ns, JSON payload).
-type ByTopic = HashMap<String, Vec<(u64, Vec<u8>)>>;
-
-fn read_messages(bytes: &[u8]) -> ByTopic {
-    let mut by_topic = ByTopic::new();
-    let mut last = 0;
-    for m in mcap::MessageStream::new(bytes).unwrap() {
-        let m = m.unwrap();
-        assert!(m.log_time >= last, "log times must not decrease");
-        last = m.log_time;
-        by_topic
-            .entry(m.channel.topic.clone())
-            .or_default()
-            .push((m.log_time, m.data.to_vec()));
-    }
-    by_topic
-}
-
 #[test]
 fn every_sample_logs_every_topic_once() {
     let dir = tempfile::tempdir().unwrap();
@@ -77,7 +59,7 @@ fn every_sample_logs_every_topic_once() {
     assert_eq!(fmu.terminate(), Fmi2Status::Ok, "{}", fmu.log_text());
 
     let bytes = std::fs::read(&path).unwrap();
-    let msgs = read_messages(&bytes);
+    let (msgs, _) = read_log_messages(&bytes);
     for (topic, _) in topics::CONTROLLER_TOPICS {
         let expected = if topic == names::CONTROLLER_LOG {
             0
@@ -162,7 +144,7 @@ fn a_fallback_is_logged_as_a_warning() {
     drop(fmu); // fmi2FreeInstance without fmi2Terminate closes the file
     let bytes = std::fs::read(&path).unwrap();
     assert!(mcap::Summary::read(&bytes).unwrap().is_some());
-    let msgs = read_messages(&bytes);
+    let (msgs, _) = read_log_messages(&bytes);
     let logs = &msgs[names::CONTROLLER_LOG];
     assert_eq!(logs.len(), 1);
     let line: Log = serde_json::from_slice(&logs[0].1).unwrap();
@@ -178,13 +160,6 @@ fn a_fallback_is_logged_as_a_warning() {
 
 #[test]
 fn a_log_file_that_cannot_be_created_is_an_error_naming_it() {
-    let fmu = logging_to("bad", Path::new("/nonexistent-dir/controller.mcap"));
-    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
-    assert_eq!(fmu.enter_init(), Fmi2Status::Ok);
-    assert_eq!(fmu.exit_init(), Fmi2Status::Error);
-    let text = fmu.last_text();
-    assert!(
-        text.contains("`log_file`") && text.contains("/nonexistent-dir/controller.mcap"),
-        "{text}"
-    );
+    let path = "/nonexistent-dir/controller.mcap";
+    assert_uncreatable_log_file_is_named(&logging_to("bad", Path::new(path)), path);
 }

@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use towing_interface::ScenarioFile;
 use towing_log::topics::Log;
-use towing_log::{LogOptions, LogWriter, RunInfo, SharedLog};
+use towing_log::{LogOptions, RunInfo, SharedLog};
 use towing_model::{
     HullModel, Scenario, TowlineModel, World, WorldConfig, WorldInputs, MAX_OBSTACLES,
 };
@@ -161,8 +161,6 @@ impl Plant {
         let Some(loaded) = self.loaded.as_ref() else {
             return Ok(());
         };
-        let mut writer = LogWriter::create(&self.params.log_file, LogOptions::default())
-            .map_err(|e| format!("parameter `log_file`: {e}"))?;
         let t = self.start_time;
         let guid = vars::DESCRIPTION.guid();
         let p = &self.params;
@@ -183,22 +181,14 @@ impl Plant {
             parameters,
             scenario_text: &loaded.text,
         };
-        let written = writer
-            .write_run(&info)
-            .and_then(|()| logging::register_topics(&mut writer))
-            .and_then(|()| {
-                logging::write_static_scene(&mut writer, t, &loaded.world, &loaded.log_info)
-            })
-            .and_then(|()| {
-                let snap = StepSnapshot::capture(t, &loaded.world, &self.inputs);
-                logging::write_state(&mut writer, &snap, &loaded.log_info)
-            });
-        if let Err(e) = written {
-            let _ = writer.finish();
-            return Err(format!("parameter `log_file`: {e}"));
-        }
-        // From here on the messages are serialized and written on the log's own thread.
-        self.log = SharedLog::spawn(writer).map_err(|e| format!("parameter `log_file`: {e}"))?;
+        // Written before the log's own thread takes over.
+        self.log = SharedLog::open(&p.log_file, LogOptions::default(), &info, |writer| {
+            logging::register_topics(writer)?;
+            logging::write_static_scene(writer, t, &loaded.world, &loaded.log_info)?;
+            let snap = StepSnapshot::capture(t, &loaded.world, &self.inputs);
+            logging::write_state(writer, &snap, &loaded.log_info)
+        })
+        .map_err(|e| format!("parameter `log_file`: {e}"))?;
         log.info(
             "logEvents",
             &format!("MCAP log {} created", self.params.log_file),

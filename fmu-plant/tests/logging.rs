@@ -5,9 +5,8 @@
 
 use fmi2_slave::ffi::Fmi2Status;
 use fmi2_slave::testing::{Exports, Fmu};
-use std::collections::HashMap;
 use std::path::Path;
-use towing_interface::testing;
+use towing_interface::testing::{self, assert_uncreatable_log_file_is_named, read_log_messages};
 use towing_log::topics::{self, names, *};
 use towing_plant::variables::{self as vars, DESCRIPTION};
 
@@ -38,25 +37,6 @@ fn steps(fmu: &Fmu, t0: f64, n: usize) -> f64 {
     t
 }
 
-/// Messages per topic, checking that times never decrease and every message decodes.
-/// Messages by topic: (log time ns, JSON payload).
-type ByTopic = HashMap<String, Vec<(u64, Vec<u8>)>>;
-
-fn read_messages(bytes: &[u8]) -> (ByTopic, u64) {
-    let mut by_topic = ByTopic::new();
-    let mut last = 0;
-    for m in mcap::MessageStream::new(bytes).unwrap() {
-        let m = m.unwrap();
-        assert!(m.log_time >= last, "log times must not decrease");
-        last = m.log_time;
-        by_topic
-            .entry(m.channel.topic.clone())
-            .or_default()
-            .push((m.log_time, m.data.to_vec()));
-    }
-    (by_topic, last)
-}
-
 #[test]
 fn a_run_logs_every_topic_once_at_the_start_and_after_each_step() {
     let dir = tempfile::tempdir().unwrap();
@@ -70,7 +50,7 @@ fn a_run_logs_every_topic_once_at_the_start_and_after_each_step() {
     assert_eq!(fmu.terminate(), Fmi2Status::Ok, "{}", fmu.log_text());
 
     let bytes = std::fs::read(&path).unwrap();
-    let (msgs, last) = read_messages(&bytes);
+    let (msgs, last) = read_log_messages(&bytes);
     assert_eq!(last, 5_000_000_000);
     for (topic, _) in topics::PLANT_TOPICS {
         let expected = match topic {
@@ -169,17 +149,8 @@ fn without_a_log_file_nothing_is_written() {
 
 #[test]
 fn a_log_file_that_cannot_be_created_is_an_error_naming_it() {
-    let fmu = plant_logging_to("bad", Path::new("/nonexistent-dir/plant.mcap"));
-    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
-    assert_eq!(fmu.enter_init(), Fmi2Status::Ok);
-    assert_eq!(fmu.exit_init(), Fmi2Status::Error);
-    let text = fmu.last_text();
-    assert!(
-        text.contains("log_file")
-            && text.contains("/nonexistent-dir/plant.mcap")
-            && text.contains("No such file"),
-        "{text}"
-    );
+    let path = "/nonexistent-dir/plant.mcap";
+    assert_uncreatable_log_file_is_named(&plant_logging_to("bad", Path::new(path)), path);
 }
 
 #[test]
@@ -197,7 +168,7 @@ fn free_instance_finishes_a_log_that_terminate_did_not() {
         .unwrap()
         .expect("a finished file");
     assert_eq!(summary.stats.unwrap().channel_message_counts.len(), 10);
-    let (msgs, _) = read_messages(&bytes);
+    let (msgs, _) = read_log_messages(&bytes);
     assert_eq!(msgs[names::PLANT_SHIP].len(), 21);
 }
 
@@ -210,7 +181,7 @@ fn a_start_time_other_than_zero_is_the_time_of_the_first_messages() {
     steps(&fmu, 100.0, 2);
     assert_eq!(fmu.terminate(), Fmi2Status::Ok);
     let bytes = std::fs::read(&path).unwrap();
-    let (msgs, last) = read_messages(&bytes);
+    let (msgs, last) = read_log_messages(&bytes);
     assert_eq!(msgs[names::PLANT_SHIP][0].0, 100_000_000_000);
     assert_eq!(last, 100_200_000_000);
 }
@@ -233,7 +204,7 @@ fn going_back_to_an_earlier_fmu_state_keeps_log_times_non_decreasing() {
     steps(&fmu, t, 15);
     assert_eq!(fmu.terminate(), Fmi2Status::Ok, "{}", fmu.log_text());
     let bytes = std::fs::read(&path).unwrap();
-    let (msgs, last) = read_messages(&bytes);
+    let (msgs, last) = read_log_messages(&bytes);
     assert_eq!(last, ((end + 0.5) * 1e9).round() as u64);
     // 0..=2.0 s first, then 2.1..=2.5 s after the replay (2.0 s itself is written again:
     // equal times are allowed).

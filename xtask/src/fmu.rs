@@ -1,7 +1,7 @@
 //! Packaging of the FMUs: release build, model description check, zip.
 //!
 //! The modelDescription.xml of each FMU is generated from the Rust variable table by the FMU
-//! crate's `model_description` binary, committed under `modelDescription/`, and packaged from
+//! crate's model description binary, committed under `modelDescription/`, and packaged from
 //! there; packaging refuses to run when the committed file differs from the generated one.
 
 use crate::{cargo, fail, output, progress, root, run, target_dir, FmuCrate, Result, FMUS};
@@ -9,7 +9,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use zip::write::SimpleFileOptions;
 
-/// Generated documents of one FMU, as printed by its `model_description` binary.
+/// Generated documents of one FMU, as printed by its model description binary.
 struct Generated {
     xml: String,
     html: String,
@@ -28,7 +28,7 @@ fn generate(fmu: &FmuCrate) -> Result<Generated> {
                 "--package",
                 fmu.package,
                 "--bin",
-                "model_description",
+                fmu.description_bin,
                 "--",
                 what,
             ]),

@@ -27,6 +27,8 @@ pub struct FmuCrate {
     pub lib_name: &'static str,
     /// FMI modelIdentifier: the binary name inside the FMU and the FMU's file name.
     pub model_identifier: &'static str,
+    /// The package's binary that prints the model description (`xml`, `html`, `markdown`).
+    pub description_bin: &'static str,
     /// Files copied into the FMU's `resources/` folder (repository-relative source, name inside).
     pub resources: &'static [(&'static str, &'static str)],
 }
@@ -37,12 +39,14 @@ pub const FMUS: &[FmuCrate] = &[
         package: "fmu-plant",
         lib_name: "towing_plant",
         model_identifier: "TowingPlant",
+        description_bin: "plant_model_description",
         resources: &[("scenarios/paper.toml", "paper.toml")],
     },
     FmuCrate {
         package: "fmu-controller",
         lib_name: "towing_controller",
         model_identifier: "TowingController",
+        description_bin: "controller_model_description",
         resources: &[("scenarios/paper.toml", "paper.toml")],
     },
 ];

@@ -67,6 +67,36 @@ impl Situation {
         }
     }
 
+    /// The situation of a [`Situation::code`] (`None` for any other number).
+    #[must_use]
+    pub fn from_code(code: i32) -> Option<Self> {
+        [
+            Self::Safe,
+            Self::HeadOn,
+            Self::CrossingGiveWay,
+            Self::CrossingStandOn,
+            Self::Overtaking,
+            Self::BeingOvertaken,
+            Self::Unclassified,
+        ]
+        .into_iter()
+        .find(|s| s.code() == code)
+    }
+
+    /// Text for logs and reports, e.g. `crossing give-way`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Safe => "safe",
+            Self::HeadOn => "head-on",
+            Self::CrossingGiveWay => "crossing give-way",
+            Self::CrossingStandOn => "crossing stand-on",
+            Self::Overtaking => "overtaking",
+            Self::BeingOvertaken => "being overtaken",
+            Self::Unclassified => "unclassified",
+        }
+    }
+
     /// The rule that defines the situation.
     #[must_use]
     pub fn rule(self) -> &'static str {

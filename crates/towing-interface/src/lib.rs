@@ -12,7 +12,7 @@
 //!   ([`ModelInfo`]).
 //! * [`scenario`]: the `scenario` String parameter (a file path, or the bundled
 //!   `resources/paper.toml`).
-//! * [`model_description_main`]: the body of each FMU's `model_description` binary.
+//! * [`model_description_main`]: the body of each FMU's model description binary (`plant_model_description`, `controller_model_description`).
 //! * `testing` (feature `testing`): in-process test helpers shared by the FMU crates.
 //!
 //! Who produces what: the plant (`TowingPlant`) outputs the vessel states, the towline
@@ -87,7 +87,7 @@ pub fn contract_names() -> Vec<String> {
     names
 }
 
-/// The body of an FMU's `model_description` binary: prints `description` as
+/// The body of an FMU's model description binary: prints `description` as
 /// `modelDescription.xml` (argument `xml` or none), as the Markdown variable table of
 /// docs/interface.md (`markdown`) or as HTML documentation (`html`); used by
 /// `cargo xtask model-description` and `cargo xtask fmu`. Exit code 2 for an unknown

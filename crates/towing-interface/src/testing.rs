@@ -7,6 +7,7 @@
 use fmi2_slave::description::ModelDescription;
 use fmi2_slave::ffi::Fmi2Status;
 use fmi2_slave::testing::{Exports, Fmu};
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// The repository (workspace) root.
@@ -139,4 +140,38 @@ macro_rules! model_description_tests {
             $crate::testing::assert_contract_names_are_declared(&$description);
         }
     };
+}
+
+/// An MCAP log's messages by topic: (log time ns, JSON payload).
+pub type LogMessages = HashMap<String, Vec<(u64, Vec<u8>)>>;
+
+/// Every message of a complete MCAP log by topic, and the last log time; asserts that log
+/// times never decrease (docs/logging.md).
+#[must_use]
+pub fn read_log_messages(bytes: &[u8]) -> (LogMessages, u64) {
+    let mut by_topic = LogMessages::new();
+    let mut last = 0;
+    for m in mcap::MessageStream::new(bytes).expect("an MCAP file") {
+        let m = m.expect("a readable message");
+        assert!(m.log_time >= last, "log times must not decrease");
+        last = m.log_time;
+        by_topic
+            .entry(m.channel.topic.clone())
+            .or_default()
+            .push((m.log_time, m.data.to_vec()));
+    }
+    (by_topic, last)
+}
+
+/// `fmu` has `log_file` set to a path in a folder that does not exist: initialization
+/// ends in fmi2Error with a message naming the parameter, the path and the reason.
+pub fn assert_uncreatable_log_file_is_named(fmu: &Fmu, path: &str) {
+    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
+    assert_eq!(fmu.enter_init(), Fmi2Status::Ok);
+    assert_eq!(fmu.exit_init(), Fmi2Status::Error);
+    let text = fmu.last_text();
+    assert!(
+        text.contains("`log_file`") && text.contains(path) && text.contains("No such file"),
+        "{text}"
+    );
 }

@@ -745,14 +745,7 @@ impl Log {
 pub fn situation_name(code: i32) -> &'static str {
     match code {
         -1 => "none",
-        0 => "safe",
-        1 => "head-on",
-        2 => "crossing give-way",
-        3 => "crossing stand-on",
-        4 => "overtaking",
-        5 => "being overtaken",
-        6 => "unclassified",
-        _ => "unknown",
+        _ => towing_guidance::Situation::from_code(code).map_or("unknown", |s| s.name()),
     }
 }
 

@@ -698,6 +698,27 @@ impl SharedLog {
         Self::with_mode(path, Mode::Inline(Some(Box::new(writer))), Arc::default())
     }
 
+    /// Creates the log at `path`, writes the run description of `info` and whatever
+    /// `setup` writes (channels, messages at the start), then hands the writer to its
+    /// own thread ([`SharedLog::spawn`]). On an error the file is finished as far as
+    /// possible and the error returned.
+    ///
+    /// # Errors
+    /// The first error of creating, writing or spawning, naming the file.
+    pub fn open(
+        path: impl AsRef<Path>,
+        options: LogOptions,
+        info: &RunInfo<'_>,
+        setup: impl FnOnce(&mut LogWriter) -> Result<(), LogError>,
+    ) -> Result<Self, LogError> {
+        let mut writer = LogWriter::create(path, options)?;
+        if let Err(e) = writer.write_run(info).and_then(|()| setup(&mut writer)) {
+            let _ = writer.finish();
+            return Err(e);
+        }
+        Self::spawn(writer)
+    }
+
     /// A log writing to `writer` on a thread of its own.
     ///
     /// # Errors
