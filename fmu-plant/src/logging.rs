@@ -193,11 +193,26 @@ impl StepSnapshot {
     }
 }
 
-/// Every per-step topic of `snap`.
+/// Whether a step from `t_prev` to `t` (both counted from the start time, s) reaches a new
+/// multiple of `interval` (s), so the Foxglove topics are due; always when `interval` is 0.
+/// A tolerance of 1e-9 of a step keeps `k * interval` reached by a sum of equal steps on
+/// time despite rounding.
+#[must_use]
+pub fn scene_due(interval: f64, t_prev: f64, t: f64) -> bool {
+    if interval <= 0.0 {
+        return true;
+    }
+    let eps = 1e-9 * (t - t_prev).abs().max(f64::MIN_POSITIVE);
+    ((t + eps) / interval).floor() > ((t_prev + eps) / interval).floor()
+}
+
+/// Every per-step topic of `snap`; the Foxglove topics `/tf` and `/plant/scene` only with
+/// `scene` (see [`scene_due`]).
 pub fn write_state(
     w: &mut LogWriter,
     snap: &StepSnapshot,
     info: &LogScenario,
+    scene: bool,
 ) -> Result<(), LogError> {
     let t = snap.t;
     let vessels = &snap.vessels;
@@ -238,15 +253,17 @@ pub fn write_state(
             tension_cmd: inputs.tension_cmd,
         },
     )?;
-    let frames = [FRAME_SHIP, FRAME_TUG1, FRAME_TUG2];
-    let transforms = FrameTransforms {
-        transforms: frames
-            .iter()
-            .zip(vessels)
-            .map(|(frame, s)| scene::frame_transform(frame, t, s.eta[0], s.eta[1], s.eta[2]))
-            .collect(),
-    };
-    w.write(names::TF, t, &transforms)?;
+    if scene {
+        let frames = [FRAME_SHIP, FRAME_TUG1, FRAME_TUG2];
+        let transforms = FrameTransforms {
+            transforms: frames
+                .iter()
+                .zip(vessels)
+                .map(|(frame, s)| scene::frame_transform(frame, t, s.eta[0], s.eta[1], s.eta[2]))
+                .collect(),
+        };
+        w.write(names::TF, t, &transforms)?;
+    }
     let obstacles: Vec<ObstacleState> = snap
         .obstacles
         .iter()
@@ -264,7 +281,9 @@ pub fn write_state(
             width: o.width,
         })
         .collect();
-    w.write(names::PLANT_SCENE, t, &moving_scene(snap, &obstacles))?;
+    if scene {
+        w.write(names::PLANT_SCENE, t, &moving_scene(snap, &obstacles))?;
+    }
     w.write(names::PLANT_OBSTACLES, t, &Obstacles { t, obstacles })
 }
 

@@ -27,15 +27,30 @@ use towing_model::{
 const STATE_FORMAT_VERSION: u16 = 1;
 const STATE_MAGIC: &[u8; 4] = b"TWPL";
 
-/// Parameter values (FMI `parameter` variables); all 0 (empty) by default: as the scenario
-/// says, the bundled scenario.
-#[derive(Debug, Clone, PartialEq, Default)]
+/// Parameter values (FMI `parameter` variables); the model parameters are all 0 (empty) by
+/// default: as the scenario says, the bundled scenario.
+#[derive(Debug, Clone, PartialEq)]
 struct Parameters {
     scenario: String,
     log_file: String,
+    /// Interval of the Foxglove topics `/tf` and `/plant/scene` in the log, s; 0: every step.
+    log_scene_interval: f64,
     hull_model: i32,
     towline_model: i32,
     integration_step: f64,
+}
+
+impl Default for Parameters {
+    fn default() -> Self {
+        Self {
+            scenario: String::new(),
+            log_file: String::new(),
+            log_scene_interval: vars::LOG_SCENE_INTERVAL_START,
+            hull_model: 0,
+            towline_model: 0,
+            integration_step: 0.0,
+        }
+    }
 }
 
 impl Parameters {
@@ -51,6 +66,12 @@ impl Parameters {
             return Err(format!(
                 "towline_model must be 0 (as the scenario says), 1 (ideal winch) or 2 (elastic line), got {}",
                 self.towline_model
+            ));
+        }
+        let d = self.log_scene_interval;
+        if !(d.is_finite() && d >= 0.0) {
+            return Err(format!(
+                "log_scene_interval must be 0 (every step) or a positive number of seconds, got {d} s"
             ));
         }
         let h = self.integration_step;
@@ -167,6 +188,7 @@ impl Plant {
         let parameters = serde_json::json!({
             "scenario": p.scenario,
             "log_file": p.log_file,
+            "log_scene_interval": p.log_scene_interval,
             "hull_model": p.hull_model,
             "towline_model": p.towline_model,
             "integration_step": p.integration_step,
@@ -186,7 +208,7 @@ impl Plant {
             logging::register_topics(writer)?;
             logging::write_static_scene(writer, t, &loaded.world, &loaded.log_info)?;
             let snap = StepSnapshot::capture(t, &loaded.world, &self.inputs);
-            logging::write_state(writer, &snap, &loaded.log_info)
+            logging::write_state(writer, &snap, &loaded.log_info, true)
         })
         .map_err(|e| format!("parameter `log_file`: {e}"))?;
         log.info(
@@ -196,13 +218,21 @@ impl Plant {
         Ok(())
     }
 
-    /// Writes the state at `t` after a step; a logging failure becomes a warning.
-    fn log_step(&self, t: f64) -> Option<String> {
+    /// Writes the state at the end `t` of the step that began at `t_prev`; the Foxglove
+    /// topics only when the step crossed a multiple of `log_scene_interval` (counted from
+    /// the start time). A logging failure becomes a warning.
+    fn log_step(&self, t_prev: f64, t: f64) -> Option<String> {
         let loaded = self.loaded.as_ref()?;
         let snap = StepSnapshot::capture(t, &loaded.world, &self.inputs);
         let info = Arc::clone(&loaded.log_info);
-        self.log
-            .batch(Box::new(move |w| logging::write_state(w, &snap, &info)))
+        let scene = logging::scene_due(
+            self.params.log_scene_interval,
+            t_prev - self.start_time,
+            t - self.start_time,
+        );
+        self.log.batch(Box::new(move |w| {
+            logging::write_state(w, &snap, &info, scene)
+        }))
     }
 
     /// Writes a warning or error the plant reports to `/plant/log`.
@@ -258,6 +288,7 @@ impl Fmi2Model for Plant {
     fn get_real(&self, vr: u32) -> f64 {
         match vr {
             vars::INTEGRATION_STEP => self.params.integration_step,
+            vars::LOG_SCENE_INTERVAL => self.params.log_scene_interval,
             200..=299 => {
                 for tug in 0..2 {
                     for c in 0..3 {
@@ -278,6 +309,13 @@ impl Fmi2Model for Plant {
     }
 
     fn set_real(&mut self, log: &Logger, vr: u32, value: f64) -> Result<(), String> {
+        if vr == vars::LOG_SCENE_INTERVAL {
+            let previous = self.params.log_scene_interval;
+            self.params.log_scene_interval = value;
+            return self.params.validate().inspect_err(|_| {
+                self.params.log_scene_interval = previous;
+            });
+        }
         if vr == vars::INTEGRATION_STEP {
             let previous = self.params.clone();
             self.params.integration_step = value;
@@ -397,7 +435,7 @@ impl Fmi2Model for Plant {
         }
         let failed = match &outcome {
             StepOutcome::Ok | StepOutcome::Warning(_) => {
-                self.log_step(step.current_time + step.step_size)
+                self.log_step(step.current_time, step.current_time + step.step_size)
             }
             StepOutcome::Discard(m) | StepOutcome::Error(m) => {
                 self.log_line(step.current_time, Log::ERROR, m)
@@ -468,6 +506,7 @@ impl Fmi2Model for Plant {
         let params = Parameters {
             scenario: r.string()?,
             log_file: String::new(),
+            log_scene_interval: self.params.log_scene_interval,
             hull_model: i32::from_le_bytes(r.array()?),
             towline_model: i32::from_le_bytes(r.array()?),
             integration_step: f64::from_le_bytes(r.array()?),

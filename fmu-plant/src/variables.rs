@@ -28,6 +28,11 @@ pub const TOWLINE_MODEL: u32 = 3;
 /// `integration_step` (Real parameter, s): largest RK4 substep.
 pub const INTEGRATION_STEP: u32 = 4;
 
+/// `log_scene_interval` (Real parameter, s): interval of `/tf` and `/plant/scene` in the log.
+pub const LOG_SCENE_INTERVAL: u32 = 5;
+/// Start value of `log_scene_interval`, s.
+pub const LOG_SCENE_INTERVAL_START: f64 = 0.5;
+
 /// Field index of the Boolean `towlineN.slack` output within a towline's value references.
 pub const TOWLINE_SLACK: u32 = 3;
 
@@ -58,11 +63,24 @@ fn build() -> ModelDescription {
         }
         kind
     };
+    let log_scene_interval = {
+        let mut kind = real_kind("s", Some(LOG_SCENE_INTERVAL_START));
+        if let VariableKind::Real { min, .. } = &mut kind {
+            *min = Some(0.0);
+        }
+        kind
+    };
     let mut v = vec![
         shared::scenario_parameter(
             "Path of the scenario file (TOML, docs/scenario-format.md); empty: the bundled paper scenario resources/paper.toml",
         ),
         shared::log_file_parameter(),
+        parameter(
+            "log_scene_interval",
+            LOG_SCENE_INTERVAL,
+            log_scene_interval,
+            "Interval of the Foxglove topics /tf and /plant/scene in the MCAP log (docs/logging.md): written at the first step that reaches each multiple of it after the start time; 0: every step. Every other plant topic is written every step",
+        ),
         parameter(
             "hull_model",
             HULL_MODEL,

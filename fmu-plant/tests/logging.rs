@@ -56,6 +56,8 @@ fn a_run_logs_every_topic_once_at_the_start_and_after_each_step() {
         let expected = match topic {
             names::PLANT_LOG => 0,
             names::PLANT_SCENE_STATIC => 1,
+            // `log_scene_interval` 0.5 s: t = 0, 0.5, ..., 5 s.
+            names::TF | names::PLANT_SCENE => n / 5 + 1,
             _ => n + 1,
         };
         assert_eq!(msgs.get(topic).map_or(0, Vec::len), expected, "{topic}");
@@ -102,7 +104,8 @@ fn a_run_logs_every_topic_once_at_the_start_and_after_each_step() {
     let scene: SceneUpdate = serde_json::from_slice(&msgs[names::PLANT_SCENE][1].1).unwrap();
     assert_eq!(scene.entities[0].id, "towlines");
     assert_eq!(scene.entities[0].lines.len(), 2);
-    assert_eq!(scene.entities[0].timestamp.nsec, 100_000_000);
+    assert_eq!(scene.entities[0].timestamp.nsec, 500_000_000);
+    assert_eq!(msgs[names::TF][1].0, 500_000_000);
     let fixed: SceneUpdate = serde_json::from_slice(&msgs[names::PLANT_SCENE_STATIC][0].1).unwrap();
     let ids: Vec<_> = fixed.entities.iter().map(|e| e.id.as_str()).collect();
     assert_eq!(
@@ -128,12 +131,71 @@ fn a_run_logs_every_topic_once_at_the_start_and_after_each_step() {
     let params: serde_json::Value = serde_json::from_str(&run.metadata["parameters"]).unwrap();
     assert_eq!(params["log_file"], path.to_str().unwrap());
     assert_eq!(params["hull_model"], 0);
+    assert_eq!(params["log_scene_interval"], 0.5);
     let att = mcap::read::attachment(&bytes, &summary.attachment_indexes[0]).unwrap();
     assert_eq!(att.name, "scenario.toml");
     assert_eq!(
         String::from_utf8(att.data.to_vec()).unwrap(),
         testing::read_repository_file("scenarios/paper.toml")
     );
+}
+
+/// Log times (ns) of `/tf` after `n` steps of `h` from `t0` with `log_scene_interval` set
+/// to `interval`; `/plant/scene` has the same times.
+fn scene_times(name: &str, interval: f64, t0: f64, h: f64, n: usize) -> Vec<u64> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(format!("{name}.mcap"));
+    let fmu = plant_logging_to(name, &path);
+    assert_eq!(
+        fmu.set_real(vars::LOG_SCENE_INTERVAL, interval),
+        Fmi2Status::Ok
+    );
+    fmu.init(t0, None);
+    let mut t = t0;
+    for _ in 0..n {
+        assert_eq!(fmu.step(t, h), Fmi2Status::Ok, "{}", fmu.log_text());
+        t += h;
+    }
+    assert_eq!(fmu.terminate(), Fmi2Status::Ok);
+    let (msgs, _) = read_log_messages(&std::fs::read(&path).unwrap());
+    let times: Vec<u64> = msgs[names::TF].iter().map(|m| m.0).collect();
+    let scene: Vec<u64> = msgs[names::PLANT_SCENE].iter().map(|m| m.0).collect();
+    assert_eq!(times, scene);
+    assert_eq!(msgs[names::PLANT_SHIP].len(), n + 1);
+    times
+}
+
+#[test]
+fn the_foxglove_topics_follow_log_scene_interval() {
+    let ms = |v: &[u64]| v.iter().map(|t| t / 1_000_000).collect::<Vec<_>>();
+    // 0: every step.
+    assert_eq!(
+        ms(&scene_times("every", 0.0, 0.0, 0.1, 4)),
+        [0, 100, 200, 300, 400]
+    );
+    // 0.25 s with 0.1 s steps: the first step reaching each multiple (0.3, 0.5, 0.8, 1.0 s),
+    // counted from the start time.
+    assert_eq!(
+        ms(&scene_times("quarter", 0.25, 10.0, 0.1, 10)),
+        [10_000, 10_300, 10_500, 10_800, 11_000]
+    );
+    // An interval longer than the run: the start only.
+    assert_eq!(ms(&scene_times("long", 100.0, 0.0, 0.1, 30)), [0]);
+}
+
+#[test]
+fn a_negative_log_scene_interval_is_refused_naming_it() {
+    let fmu = testing::instantiate(exports(), &DESCRIPTION, "negative");
+    assert_eq!(
+        fmu.set_real(vars::LOG_SCENE_INTERVAL, -1.0),
+        Fmi2Status::Error
+    );
+    assert!(
+        fmu.log_text().contains("log_scene_interval must be 0"),
+        "{}",
+        fmu.log_text()
+    );
+    assert_eq!(fmu.get_real(vars::LOG_SCENE_INTERVAL), 0.5);
 }
 
 #[test]

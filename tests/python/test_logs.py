@@ -1,8 +1,9 @@
 """The MCAP logs of both FMUs (docs/logging.md), written by a closed loop under fmpy
 (masters/closed_loop.py --log-dir) and read with the Python `mcap` package:
 
-- message counts per topic match the run (plant: one per step plus one at the start;
-  controller: one per control sample);
+- message counts per topic match the run (plant: one per step plus one at the start, the
+  Foxglove topics `/tf` and `/plant/scene` one per `log_scene_interval` = 0.5 s plus one at
+  the start; controller: one per control sample);
 - every message validates against its channel's JSON schema (jsonschema);
 - log times never decrease within a file, and equal the `t` the messages carry;
 - the `run` metadata and the `scenario.toml` attachment are there;
@@ -32,9 +33,9 @@ PLANT_TOPICS = [
     "/plant/towline2",
     "/plant/obstacles",
     "/plant/inputs",
-    "/tf",
-    "/plant/scene",
 ]
+# Written at the start and then every `log_scene_interval` (0.5 s by default, 5 steps).
+PLANT_SCENE_TOPICS = ["/tf", "/plant/scene"]
 CONTROLLER_TOPICS = [
     "/controller/reference",
     "/controller/colregs",
@@ -110,13 +111,15 @@ def test_message_counts_match_the_run(logged_run):
     plant = counts(read_all(logs / "plant.mcap"))
     for topic in PLANT_TOPICS:
         assert plant.get(topic) == steps + 1, (topic, plant)
+    for topic in PLANT_SCENE_TOPICS:
+        assert plant.get(topic) == steps // 5 + 1, (topic, plant)
     assert plant.get("/plant/scene_static") == 1
     ctrl = counts(read_all(logs / "controller.mcap"))
     for topic in CONTROLLER_TOPICS:
         assert ctrl.get(topic) == samples, (topic, ctrl)
     assert ctrl.get("/controller/log", 0) == summary["fallbacks"]
     # Every channel of the contract exists, with or without messages.
-    for name, expected in (("plant.mcap", PLANT_TOPICS + ["/plant/scene_static", "/plant/log"]),
+    for name, expected in (("plant.mcap", PLANT_TOPICS + PLANT_SCENE_TOPICS + ["/plant/scene_static", "/plant/log"]),
                            ("controller.mcap", CONTROLLER_TOPICS + ["/controller/log"])):
         with open(logs / name, "rb") as f:
             channels = {c.topic for c in make_reader(f).get_summary().channels.values()}

@@ -148,10 +148,11 @@ fn package(fmu: &FmuCrate) -> Result<PathBuf> {
     Ok(fmu_path)
 }
 
-/// Writes a deterministic zip (fixed timestamps, fixed order) via a temporary file, so a
-/// master never sees a half-written FMU.
+/// Writes a deterministic zip (fixed timestamps, fixed order) via a temporary file of this
+/// process, so a master never sees a half-written FMU and two packagings at once (two test
+/// runs) do not take each other's file away.
 fn write_zip(path: &Path, entries: &[(String, Vec<u8>)]) -> std::result::Result<(), String> {
-    let tmp = path.with_extension("fmu.tmp");
+    let tmp = path.with_extension(format!("fmu.{}.tmp", std::process::id()));
     let file = std::fs::File::create(&tmp).map_err(|e| format!("{}: {e}", tmp.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let options = SimpleFileOptions::default()
@@ -169,5 +170,6 @@ fn write_zip(path: &Path, entries: &[(String, Vec<u8>)]) -> std::result::Result<
     }
     zip.finish()
         .map_err(|e| format!("{}: {e}", tmp.display()))?;
-    std::fs::rename(&tmp, path).map_err(|e| format!("{}: {e}", path.display()))
+    std::fs::rename(&tmp, path)
+        .map_err(|e| format!("renaming {} to {}: {e}", tmp.display(), path.display()))
 }

@@ -1,7 +1,9 @@
 //! The writer's cost per simulated step of the plant's log (docs/logging.md): the nine
 //! per-step topics of the paper scenario (three vessel states, two towlines, inputs, `/tf`,
 //! the moving scene with two towlines and two target ships, five obstacles), serialized,
-//! compressed and written on the calling thread (what the FMUs' writer thread does).
+//! compressed and written on the calling thread (what the FMUs' writer thread does). This is
+//! the plant with `log_scene_interval = 0`; by default it writes `/tf` and the moving scene
+//! only every 0.5 s (docs/logging.md).
 //! Run with `cargo bench -p towing-log --bench write`.
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
