@@ -9,6 +9,14 @@ communication step h in Gauss-Seidel order, the controller first:
         controller outputs      -> plant inputs
         plant.doStep(t, h)
 
+or, with --coupling jacobi, in Jacobi order (as libcosim and fmpy's SSP runner do; the plant
+then applies over (t, t + h] the commands the controller computed in the step before):
+
+    for t = 0, h, 2h, ... < stop time:
+        plant outputs(t)        -> controller inputs
+        controller outputs(t)   -> plant inputs
+        controller.doStep(t, h), plant.doStep(t, h)
+
 Connections are discovered from the two modelDescriptions, never listed by hand: every
 controller input takes the plant output of the same name, every plant input takes the
 controller output of the same name (the interface contract of DESIGN.md and
@@ -32,6 +40,7 @@ Options:
     --param NAME=VALUE              any controller parameter, typed from its
                                     modelDescription (repeatable)
     --plant-param NAME=VALUE        the same for the plant (e.g. hull_model=1)
+    --coupling {gauss-seidel,jacobi}  order of a communication step (default gauss-seidel)
     --log-dir DIR                   MCAP logs (docs/logging.md): sets `log_file` to
                                     DIR/plant.mcap and DIR/controller.mcap (created)
     --out DIR (out/closed-loop), --map-size WxH (pixels, 1400x1200), --quiet
@@ -42,7 +51,8 @@ Writes:
                         after initialization and one row per communication step. Row k
                         (t_k = k h) holds the plant outputs at t_k and the controller outputs
                         after controller.doStep(t_{k-1}, h), i.e. the commands the plant
-                        applied over (t_{k-1}, t_k]. Booleans are written as 0/1.
+                        applied over (t_{k-1}, t_k] (with --coupling jacobi, over
+                        (t_k, t_{k+1}]). Booleans are written as 0/1.
     DIR/map.png         East horizontal, North vertical, equal aspect: route, ship and tug
                         tracks, static hazards and target ships at real size, vessel
                         outlines every ~100 s, start and end markers.
@@ -382,10 +392,17 @@ def run(args, log):
             step = times[k + 1] - t
             # plant outputs(t) are in plant.out_np (read after the previous step)
             warnings += transfer(plant, ctrl)
-            warnings += ctrl.do_step(t, step)
-            warnings += ctrl.read_outputs()
-            warnings += transfer(ctrl, plant)
-            warnings += plant.do_step(t, step)
+            if args.coupling == "jacobi":
+                # controller outputs(t) are in ctrl.out_np (read after the previous step)
+                warnings += transfer(ctrl, plant)
+                warnings += ctrl.do_step(t, step)
+                warnings += plant.do_step(t, step)
+                warnings += ctrl.read_outputs()
+            else:
+                warnings += ctrl.do_step(t, step)
+                warnings += ctrl.read_outputs()
+                warnings += transfer(ctrl, plant)
+                warnings += plant.do_step(t, step)
             warnings += plant.read_outputs()
             record(k + 1)
             if not args.quiet and times[k + 1] >= next_progress - 1e-9:
@@ -405,6 +422,7 @@ def run(args, log):
         summary["loop_thread_cpu_time_s"] = time.thread_time() - cpu0
         summary["architecture"] = args.architecture if args.architecture is not None else _start(ctrl, "architecture")
         summary["avoidance_scheme"] = args.scheme if args.scheme is not None else _start(ctrl, "avoidance_scheme")
+        summary["coupling"] = args.coupling
         if log_files:
             summary["log_files"] = log_files
         for u in units:
@@ -650,6 +668,13 @@ def build_parser():
     p.add_argument("--scheme", type=int, choices=(1, 2, 3), help="controller `avoidance_scheme`: scheme I, II or III of Du et al. (2022) (default: the FMU's start value)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", default=[], help="set any controller parameter, typed from its modelDescription (repeatable)")
     p.add_argument("--plant-param", action="append", metavar="NAME=VALUE", default=[], help="set a plant parameter, e.g. hull_model=1 (repeatable)")
+    p.add_argument(
+        "--coupling",
+        choices=("gauss-seidel", "jacobi"),
+        default="gauss-seidel",
+        help="gauss-seidel: the controller steps first and the plant applies its new commands in the same step (default); "
+        "jacobi: both step on the other's outputs at the step's start, as libcosim and fmpy's SSP runner do",
+    )
     p.add_argument("--log-dir", default=None, metavar="DIR", help="write MCAP logs DIR/plant.mcap and DIR/controller.mcap (the FMUs' `log_file` parameters; default: no logs)")
     p.add_argument("--out", default="out/closed-loop", metavar="DIR", help="output directory (default: out/closed-loop)")
     p.add_argument("--map-size", type=parse_size, default=(1400, 1200), metavar="WxH", help="size of map.png in pixels (default: 1400x1200)")

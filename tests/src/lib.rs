@@ -2,6 +2,8 @@
 //! through `cargo xtask fmu` (the same command users run), once per test binary.
 #![forbid(unsafe_code)]
 
+pub mod closed_loop;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;

@@ -1,8 +1,9 @@
 //! The packaged FMUs through a Rust importer (fmi-rs 0.3, the code behind fmusim): the
-//! validator on both, a plant run, and the closed loop of both FMUs connected by name,
-//! no Python involved.
+//! validator on both, a plant run, and the closed loop of both FMUs connected by name in
+//! both couplings (`e2e_tests::closed_loop`), no Python involved.
 #![allow(non_snake_case, clippy::unwrap_used, clippy::expect_used)]
 
+use e2e_tests::closed_loop::{run_closed_loop, Coupling, InitialInputs, Trajectory};
 use e2e_tests::packaged_fmu;
 use fmi_rs::fmi2::builder::FMU2Builder;
 use fmi_rs::fmi2::types::fmi2Status;
@@ -23,101 +24,88 @@ fn fmi_rs_validator_reports_no_problems() {
     }
 }
 
-/// `(from value reference, to value reference)` pairs of one type.
-type Pairs = Vec<(u32, u32)>;
+/// The closed loop in `coupling` over `steps` steps of 0.1 s (paper scenario).
+fn closed_loop(coupling: Coupling, steps: u32) -> Trajectory {
+    run_closed_loop(
+        &packaged_fmu("TowingPlant"),
+        &packaged_fmu("TowingController"),
+        coupling,
+        InitialInputs::Exchanged,
+        0.1,
+        steps,
+    )
+    .unwrap_or_else(|e| panic!("{coupling:?}: {e}"))
+}
 
-/// Connections by identical names, per type (Real, Integer, Boolean).
-fn connections(from: &ModelDescription, to: &ModelDescription) -> (Pairs, Pairs, Pairs) {
-    use fmi_rs::model_description::fmi2::{Causality, VariableType};
-    let (mut reals, mut ints, mut bools) = (Vec::new(), Vec::new(), Vec::new());
-    for input in to
-        .modelVariables
-        .iter()
-        .filter(|v| matches!(v.causality, Causality::Input))
-    {
-        let Ok(output) = from.variable_by_name(&input.name) else {
-            continue;
-        };
-        assert!(
-            matches!(output.causality, Causality::Output),
-            "{} is not an output",
-            input.name
-        );
-        let pair = (output.valueReference, input.valueReference);
-        match input.variableType {
-            VariableType::Real { .. } => reals.push(pair),
-            VariableType::Integer { .. } => ints.push(pair),
-            VariableType::Boolean { .. } => bools.push(pair),
-            _ => panic!("{}: unexpected type", input.name),
-        }
-    }
-    (reals, ints, bools)
+/// Distance the ship made good along the route's first leg (course 101.3 deg).
+fn along_route(t: &Trajectory) -> f64 {
+    let (x, y) = (t.column("ship.x").unwrap(), t.column("ship.y").unwrap());
+    let psi0 = 101.3_f64.to_radians();
+    let n = x.len() - 1;
+    (x[n] - x[0]) * psi0.cos() + (y[n] - y[0]) * psi0.sin()
 }
 
 /// Both FMUs, connected by name, Gauss-Seidel with the controller first, 0.1 s steps,
-/// 120 s of the paper scenario: every command within its bound, the ship under way
-/// along the route, the controller's sample counter at one per second.
+/// 120 s of the paper scenario: every command finite, the ship under way along the route,
+/// the controller's sample counter at one per second.
 #[test]
 fn closed_loop_under_fmi_rs() {
-    let plant_b = FMU2Builder::new(&packaged_fmu("TowingPlant")).unwrap();
-    let ctrl_b = FMU2Builder::new(&packaged_fmu("TowingController")).unwrap();
-    let (p_md, c_md) = (&plant_b.model_description, &ctrl_b.model_description);
-    let to_ctrl = connections(p_md, c_md);
-    let to_plant = connections(c_md, p_md);
-    assert_eq!(to_plant.0.len(), 8, "six thrusts and two tension commands");
-    assert!(to_ctrl.0.len() >= 18 + 6 * 8, "vessel states and obstacles");
-    let plant = plant_b.instantiate_cs("plant").unwrap();
-    let ctrl = ctrl_b.instantiate_cs("controller").unwrap();
-    for fmu in [&plant, &ctrl] {
-        assert_eq!(fmu.setupExperiment(None, 0.0, Some(120.0)), fmi2Status::Ok);
-        assert_eq!(fmu.enterInitializationMode(), fmi2Status::Ok);
-        assert_eq!(fmu.exitInitializationMode(), fmi2Status::Ok);
-    }
-    let copy_reals = |from: &fmi_rs::fmi2::FMU2<fmi_rs::fmi2::CS>,
-                      to: &fmi_rs::fmi2::FMU2<fmi_rs::fmi2::CS>,
-                      c: &[(u32, u32)]| {
-        let (src, dst): (Vec<u32>, Vec<u32>) = c.iter().copied().unzip();
-        let mut v = vec![0.0; src.len()];
-        assert_eq!(from.getReal(&src, &mut v), fmi2Status::Ok);
-        assert_eq!(to.setReal(&dst, &v), fmi2Status::Ok);
-        v
-    };
-    let copy_ints = |from: &fmi_rs::fmi2::FMU2<fmi_rs::fmi2::CS>,
-                     to: &fmi_rs::fmi2::FMU2<fmi_rs::fmi2::CS>,
-                     c: &[(u32, u32)]| {
-        let (src, dst): (Vec<u32>, Vec<u32>) = c.iter().copied().unzip();
-        let mut v = vec![0; src.len()];
-        assert_eq!(from.getInteger(&src, &mut v), fmi2Status::Ok);
-        assert_eq!(to.setInteger(&dst, &v), fmi2Status::Ok);
-    };
-    let vr = |md: &ModelDescription, name: &str| md.variable_by_name(name).unwrap().valueReference;
-    let ship = [vr(p_md, "ship.x"), vr(p_md, "ship.y")];
-    let mut start = [0.0; 2];
-    assert_eq!(plant.getReal(&ship, &mut start), fmi2Status::Ok);
-    for k in 0..1200 {
-        let t = f64::from(k) * 0.1;
-        copy_reals(&plant, &ctrl, &to_ctrl.0);
-        copy_ints(&plant, &ctrl, &to_ctrl.1);
-        assert!(to_ctrl.2.is_empty());
-        let status = ctrl.doStep(t, 0.1, 1);
-        assert_eq!(status, fmi2Status::Ok, "controller at t = {t}");
-        let commands = copy_reals(&ctrl, &plant, &to_plant.0);
-        for (name_vr, value) in to_plant.0.iter().zip(&commands) {
-            assert!(value.is_finite(), "command vr {} = {value}", name_vr.0);
-        }
-        assert_eq!(plant.doStep(t, 0.1, 1), fmi2Status::Ok, "plant at t = {t}");
-    }
-    let mut end = [0.0; 2];
-    assert_eq!(plant.getReal(&ship, &mut end), fmi2Status::Ok);
-    let psi0 = 101.3_f64.to_radians();
-    let along = (end[0] - start[0]) * psi0.cos() + (end[1] - start[1]) * psi0.sin();
-    assert!(along > 4.0, "ship moved {along} m along the route in 120 s");
-    let mut samples = [0];
-    assert_eq!(
-        ctrl.getInteger(&[vr(c_md, "controller.samples")], &mut samples),
-        fmi2Status::Ok
+    let t = closed_loop(Coupling::GaussSeidel, 1200);
+    assert_eq!(t.to_plant.len(), 8, "six thrusts and two tension commands");
+    assert!(
+        t.to_controller.len() >= 18 + 7 * 8,
+        "vessel states and obstacles"
     );
-    assert_eq!(samples[0], 120);
+    assert_eq!(t.warnings, 0, "no fmi2Warning (no MPC fallback)");
+    for name in &t.to_plant {
+        let command = t.column(name).unwrap();
+        assert!(command.iter().all(|v| v.is_finite()), "{name}: {command:?}");
+    }
+    let along = along_route(&t);
+    assert!(along > 4.0, "ship moved {along} m along the route in 120 s");
+    assert_eq!(
+        *t.column("controller.samples").unwrap().last().unwrap(),
+        120.0
+    );
+}
+
+/// The Jacobi coupling (libcosim's and fmpy's SSP runner's order: both FMUs step on the
+/// other's outputs at the step's start) runs the same scenario, is deterministic to the bit
+/// (every output but the wall-clock compute time), and gives another trajectory than Gauss-Seidel (the plant applies each command one step
+/// later): the cross-check of the masters (tests/python/test_systems.py) compares like with
+/// like, and would notice a master that silently uses the other order.
+#[test]
+fn jacobi_coupling_under_fmi_rs_is_deterministic_and_differs_from_gauss_seidel() {
+    let jacobi = closed_loop(Coupling::Jacobi, 600);
+    let again = closed_loop(Coupling::Jacobi, 600);
+    assert_eq!(jacobi.columns, again.columns);
+    for name in &jacobi.columns {
+        if name == "controller.compute_time" {
+            continue; // wall-clock time of a sample
+        }
+        let (a, b) = (jacobi.column(name).unwrap(), again.column(name).unwrap());
+        let same = a.iter().zip(&b).all(|(p, q)| p.to_bits() == q.to_bits());
+        assert!(same, "{name}: reruns differ");
+    }
+    assert_eq!(jacobi.warnings, 0);
+    let along = along_route(&jacobi);
+    assert!(along > 1.5, "ship moved {along} m along the route in 60 s");
+    let gauss_seidel = closed_loop(Coupling::GaussSeidel, 600);
+    let mut largest = 0.0_f64;
+    for name in ["ship.x", "ship.y", "ship.psi"] {
+        let (a, b) = (
+            jacobi.column(name).unwrap(),
+            gauss_seidel.column(name).unwrap(),
+        );
+        assert_eq!(a[0], b[0], "{name}: same initial state");
+        for (p, q) in a.iter().zip(&b) {
+            largest = largest.max((p - q).abs());
+        }
+    }
+    assert!(
+        largest > 1e-6 && largest < 1.0,
+        "Jacobi and Gauss-Seidel differ by {largest} (expected: visibly, but both sane)"
+    );
 }
 
 #[test]

@@ -4,8 +4,10 @@
 //! cargo xtask fmu                 build release libraries, package target/fmu/<Model>.fmu
 //! cargo xtask model-description   regenerate modelDescription/<Model>.xml from the Rust tables
 //! cargo xtask python              create/refresh the Python environment in .venv
+//! cargo xtask ssp [--update]      systems/towing.ssp and the OSP files (docs/masters.md)
 //! cargo xtask test                the README's test command: everything CI checks
-//! cargo xtask demo                the README's main command
+//! cargo xtask demo                the README's main command (out/paper/report.html)
+//! cargo xtask reproduce           the paper's six runs and docs/RESULTS.md
 //! ```
 //!
 //! Every step prints what it does; a failing step names itself and the reason.
@@ -17,6 +19,8 @@ use std::process::{Command, ExitCode};
 
 mod fmu;
 mod python;
+mod runs;
+mod systems;
 
 /// One FMU of the workspace: the crate that builds it and its identifiers.
 #[derive(Debug, Clone, Copy)]
@@ -152,9 +156,13 @@ commands:
   fmu                 build the release libraries and write target/fmu/<Model>.fmu
   model-description   regenerate modelDescription/<Model>.xml from the Rust variable tables
   python              create or refresh the Python environment (.venv) with fmpy and libcosimpy
+  ssp [--update]      package the FMUs, write systems/towing.ssp (SSP 1.0) and check (--update:
+                      rewrite) systems/OspSystemStructure.xml and the OSP model descriptions
   test                run every check CI runs (fmt, clippy, FMU packaging, Rust and Python tests)
-  demo                package both FMUs and run the closed loop on the paper scenario under fmpy
-                      (writes out/paper/map.png, timeseries.csv, summary.json)";
+  demo                package both FMUs, run the closed loop on the paper scenario under fmpy with
+                      MCAP logs and the analyzer's report (writes out/paper/report.html)
+  reproduce           the paper's runs (distributed and centralized, schemes I, II, III) into
+                      out/reproduce/, analyzer compare, and docs/RESULTS.md's tables and figures";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -162,8 +170,10 @@ fn main() -> ExitCode {
         Some("fmu") => fmu::package_all().map(|_| ()),
         Some("model-description") => fmu::write_model_descriptions(),
         Some("python") => python::ensure_env().map(|_| ()),
+        Some("ssp") => systems::run(&args[1..]),
         Some("test") => test_all(),
-        Some("demo") => demo(),
+        Some("demo") => runs::demo(),
+        Some("reproduce") => runs::reproduce(),
         Some("-h" | "--help" | "help") => {
             progress(USAGE);
             Ok(())
@@ -211,47 +221,5 @@ fn test_all() -> Result<()> {
         Command::new(&python).args(["-m", "pytest", "tests/python", "-q", "-ra"]),
     )?;
     progress("all checks passed");
-    Ok(())
-}
-
-/// The README's main command: both FMUs in closed loop under fmpy on the paper scenario
-/// for 1200 s (`masters/closed_loop.py`), writing `out/paper/` (map, time series, summary).
-/// The plant alone under constant inputs stays available as `masters/plant_demo.py`.
-fn demo() -> Result<()> {
-    const STEP: &str = "demo";
-    let python = python::ensure_env()?;
-    let fmus = fmu::package_all()?;
-    let find = |model: &str| {
-        fmus.iter()
-            .find(|p| {
-                p.file_name()
-                    .is_some_and(|n| n == format!("{model}.fmu").as_str())
-            })
-            .cloned()
-            .ok_or_else(|| StepError {
-                step: STEP.into(),
-                reason: format!("{model}.fmu was not packaged"),
-            })
-    };
-    let plant = find("TowingPlant")?;
-    let controller = find("TowingController")?;
-    let out = root().join("out/paper");
-    run(
-        "closed loop under fmpy (paper scenario, 1200 s)",
-        Command::new(&python)
-            .arg("masters/closed_loop.py")
-            .arg("--plant")
-            .arg(&plant)
-            .arg("--controller")
-            .arg(&controller)
-            .arg("--out")
-            .arg(&out),
-    )?;
-    progress(&format!(
-        "demo finished: map {}, time series {}, summary {}",
-        out.join("map.png").display(),
-        out.join("timeseries.csv").display(),
-        out.join("summary.json").display()
-    ));
     Ok(())
 }

@@ -1,0 +1,405 @@
+//! The closed loop of the packaged FMUs through a Rust importer (fmi-rs 0.3), in either
+//! coupling, for the integration tests (`tests/tests/fmi_rs.rs`) and the cross-check of the
+//! masters (`examples/closed_loop_csv.rs`, read by `tests/python/test_systems.py`).
+//!
+//! Connections by identical names, as `masters/closed_loop.py` makes them: every controller
+//! input takes the plant output of the same name, every plant input the controller output of
+//! the same name; an input without such an output, or of another type, is an error.
+//! Initialization as in that master: the plant is initialized first, its outputs are set on
+//! the controller in the controller's initialization mode, and the controller's outputs after
+//! its initialization are set on the plant.
+
+use fmi_rs::fmi2::builder::FMU2Builder;
+use fmi_rs::fmi2::types::fmi2Status;
+use fmi_rs::fmi2::{CS, FMU2};
+use fmi_rs::model_description::fmi2::{Causality, ModelDescription, VariableType};
+use std::path::Path;
+use std::sync::Arc;
+
+/// Order of the two FMUs within a communication step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Coupling {
+    /// The controller steps on the plant's outputs at t, then the plant steps with the
+    /// controller's new outputs (`masters/closed_loop.py`'s default).
+    GaussSeidel,
+    /// Both step on the other's outputs at t; outputs are exchanged after both steps
+    /// (libcosim's fixed-step algorithm, fmpy's SSP runner).
+    Jacobi,
+}
+
+impl std::str::FromStr for Coupling {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "gauss-seidel" => Ok(Self::GaussSeidel),
+            "jacobi" => Ok(Self::Jacobi),
+            other => Err(format!(
+                "unknown coupling {other:?} (gauss-seidel or jacobi)"
+            )),
+        }
+    }
+}
+
+/// Initial values of the connected inputs before the first step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InitialInputs {
+    /// The other FMU's outputs after initialization (every master of this workspace and
+    /// libcosim).
+    Exchanged,
+    /// Every connected input 0 at the first step and nothing exchanged during
+    /// initialization: what fmpy's SSP runner (`fmpy.ssp.simulate_ssp`) does, to reproduce
+    /// its trajectory.
+    Zero,
+}
+
+/// A closed-loop run: `columns` = `time`, every plant output, every controller output (in
+/// modelDescription order, Integer and Boolean outputs as numbers); `rows[k]` at t = k h:
+/// row 0 after initialization, row k after the k-th communication step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trajectory {
+    pub columns: Vec<String>,
+    pub rows: Vec<Vec<f64>>,
+    /// Names of the controller inputs fed by the plant, and of the plant inputs fed by the
+    /// controller.
+    pub to_controller: Vec<String>,
+    pub to_plant: Vec<String>,
+    /// fmi2Warning statuses returned (an MPC fallback is one).
+    pub warnings: usize,
+}
+
+impl Trajectory {
+    /// The values of one column over time.
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let i = self.columns.iter().position(|c| c == name)?;
+        Some(self.rows.iter().map(|r| r[i]).collect())
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Real,
+    Integer,
+    Boolean,
+}
+
+fn kind(v: &VariableType) -> Option<Kind> {
+    match v {
+        VariableType::Real { .. } => Some(Kind::Real),
+        VariableType::Integer { .. } | VariableType::Enumeration { .. } => Some(Kind::Integer),
+        VariableType::Boolean { .. } => Some(Kind::Boolean),
+        _ => None,
+    }
+}
+
+const KINDS: [Kind; 3] = [Kind::Real, Kind::Integer, Kind::Boolean];
+
+/// Per kind (Real, Integer, Boolean): (index into the sender's outputs of that kind, input
+/// value reference).
+type Inputs = [Vec<(usize, u32)>; 3];
+
+/// One instance with its outputs (read once per step, by type) and its connected inputs.
+struct Unit {
+    name: &'static str,
+    fmu: Arc<FMU2<CS>>,
+    /// Per kind: names and value references of the outputs.
+    out_names: [Vec<String>; 3],
+    out_vr: [Vec<u32>; 3],
+    reals: Vec<f64>,
+    ints: Vec<i32>,
+    bools: Vec<i32>,
+    /// The connected inputs, fed from the other unit's outputs.
+    inputs: Inputs,
+}
+
+fn check(status: fmi2Status, what: &str, warnings: &mut usize) -> Result<(), String> {
+    match status {
+        fmi2Status::Ok => Ok(()),
+        fmi2Status::Warning => {
+            *warnings += 1;
+            Ok(())
+        }
+        other => Err(format!("{what}: {other:?}")),
+    }
+}
+
+impl Unit {
+    fn new(name: &'static str, fmu: Arc<FMU2<CS>>, md: &ModelDescription) -> Self {
+        let mut out_names: [Vec<String>; 3] = Default::default();
+        let mut out_vr: [Vec<u32>; 3] = Default::default();
+        for v in md
+            .modelVariables
+            .iter()
+            .filter(|v| matches!(v.causality, Causality::Output))
+        {
+            if let Some(k) = kind(&v.variableType) {
+                out_names[k as usize].push(v.name.clone());
+                out_vr[k as usize].push(v.valueReference);
+            }
+        }
+        Self {
+            name,
+            fmu,
+            reals: vec![0.0; out_vr[0].len()],
+            ints: vec![0; out_vr[1].len()],
+            bools: vec![0; out_vr[2].len()],
+            out_names,
+            out_vr,
+            inputs: Default::default(),
+        }
+    }
+
+    fn read_outputs(&mut self, warnings: &mut usize) -> Result<(), String> {
+        let what = format!("{}: reading outputs", self.name);
+        check(
+            self.fmu.getReal(&self.out_vr[0], &mut self.reals),
+            &what,
+            warnings,
+        )?;
+        check(
+            self.fmu.getInteger(&self.out_vr[1], &mut self.ints),
+            &what,
+            warnings,
+        )?;
+        check(
+            self.fmu.getBoolean(&self.out_vr[2], &mut self.bools),
+            &what,
+            warnings,
+        )
+    }
+
+    /// Sets this unit's connected inputs from `sender`'s last outputs (or to 0).
+    fn take_inputs(&self, sender: Option<&Unit>, warnings: &mut usize) -> Result<(), String> {
+        let what = format!("{}: setting inputs", self.name);
+        for k in KINDS {
+            let c = &self.inputs[k as usize];
+            if c.is_empty() {
+                continue;
+            }
+            let vrs: Vec<u32> = c.iter().map(|(_, vr)| *vr).collect();
+            let status = match k {
+                Kind::Real => {
+                    let v: Vec<f64> = c
+                        .iter()
+                        .map(|(i, _)| sender.map_or(0.0, |s| s.reals[*i]))
+                        .collect();
+                    self.fmu.setReal(&vrs, &v)
+                }
+                Kind::Integer => {
+                    let v: Vec<i32> = c
+                        .iter()
+                        .map(|(i, _)| sender.map_or(0, |s| s.ints[*i]))
+                        .collect();
+                    self.fmu.setInteger(&vrs, &v)
+                }
+                Kind::Boolean => {
+                    let v: Vec<i32> = c
+                        .iter()
+                        .map(|(i, _)| sender.map_or(0, |s| s.bools[*i]))
+                        .collect();
+                    self.fmu.setBoolean(&vrs, &v)
+                }
+            };
+            check(status, &what, warnings)?;
+        }
+        Ok(())
+    }
+
+    fn values(&self) -> impl Iterator<Item = f64> + '_ {
+        self.reals
+            .iter()
+            .copied()
+            .chain(self.ints.iter().map(|&i| f64::from(i)))
+            .chain(self.bools.iter().map(|&b| f64::from(b)))
+    }
+
+    fn column_names(&self) -> impl Iterator<Item = &String> + '_ {
+        self.out_names.iter().flatten()
+    }
+}
+
+/// For every input of `receiver`: (index of the same-name output among `sender`'s outputs
+/// of its kind, input value reference), per kind. Errors name every input that cannot be fed.
+fn connect(
+    sender: &Unit,
+    sender_md: &ModelDescription,
+    receiver_md: &ModelDescription,
+    receiver_name: &str,
+) -> Result<(Inputs, Vec<String>), String> {
+    let mut inputs: Inputs = Default::default();
+    let mut names = Vec::new();
+    let mut problems = Vec::new();
+    for input in receiver_md
+        .modelVariables
+        .iter()
+        .filter(|v| matches!(v.causality, Causality::Input))
+    {
+        let output = sender_md
+            .modelVariables
+            .iter()
+            .find(|v| v.name == input.name && matches!(v.causality, Causality::Output));
+        match (output, kind(&input.variableType)) {
+            (None, _) => problems.push(format!(
+                "{receiver_name} input '{}' has no {} output of the same name",
+                input.name, sender.name
+            )),
+            (Some(_), None) => problems.push(format!(
+                "{receiver_name} input '{}' has a type the masters do not connect",
+                input.name
+            )),
+            (Some(o), Some(k)) if kind(&o.variableType) != Some(k) => problems.push(format!(
+                "{receiver_name} input '{}' and the {} output of that name differ in type",
+                input.name, sender.name
+            )),
+            (Some(_), Some(k)) => {
+                let index = sender.out_names[k as usize]
+                    .iter()
+                    .position(|n| *n == input.name)
+                    .ok_or_else(|| format!("{}: output '{}' not found", sender.name, input.name))?;
+                inputs[k as usize].push((index, input.valueReference));
+                names.push(input.name.clone());
+            }
+        }
+    }
+    if problems.is_empty() {
+        Ok((inputs, names))
+    } else {
+        Err(format!(
+            "cannot connect the FMUs by name:\n  {}",
+            problems.join("\n  ")
+        ))
+    }
+}
+
+/// Runs `steps` communication steps of `step` seconds from t = 0 (the plant's default
+/// scenario, every parameter at its start value).
+///
+/// # Errors
+/// When an FMU cannot be loaded or connected, or returns fmi2Discard, fmi2Error or
+/// fmi2Fatal (the message names the call and the time).
+pub fn run_closed_loop(
+    plant_fmu: &Path,
+    controller_fmu: &Path,
+    coupling: Coupling,
+    initial_inputs: InitialInputs,
+    step: f64,
+    steps: u32,
+) -> Result<Trajectory, String> {
+    let load = |p: &Path| FMU2Builder::new(&p).map_err(|e| format!("{}: {e}", p.display()));
+    let plant_b = load(plant_fmu)?;
+    let ctrl_b = load(controller_fmu)?;
+    let (p_md, c_md) = (&plant_b.model_description, &ctrl_b.model_description);
+    let instantiate = |b: &FMU2Builder, name: &str| {
+        b.instantiate_cs(name)
+            .map_err(|e| format!("instantiating {name}: {e}"))
+    };
+    let mut plant = Unit::new("plant", instantiate(&plant_b, "plant")?, p_md);
+    let mut ctrl = Unit::new("controller", instantiate(&ctrl_b, "controller")?, c_md);
+    let (to_ctrl, to_controller) = connect(&plant, p_md, c_md, "controller")?;
+    let (to_plant_inputs, to_plant) = connect(&ctrl, c_md, p_md, "plant")?;
+    ctrl.inputs = to_ctrl;
+    plant.inputs = to_plant_inputs;
+
+    let mut warnings = 0;
+    let w = &mut warnings;
+    let stop = f64::from(steps) * step;
+    let exchanged = initial_inputs == InitialInputs::Exchanged;
+    check(
+        plant.fmu.setupExperiment(None, 0.0, Some(stop)),
+        "plant: setupExperiment",
+        w,
+    )?;
+    check(
+        plant.fmu.enterInitializationMode(),
+        "plant: enterInitializationMode",
+        w,
+    )?;
+    check(
+        plant.fmu.exitInitializationMode(),
+        "plant: exitInitializationMode",
+        w,
+    )?;
+    check(
+        ctrl.fmu.setupExperiment(None, 0.0, Some(stop)),
+        "controller: setupExperiment",
+        w,
+    )?;
+    check(
+        ctrl.fmu.enterInitializationMode(),
+        "controller: enterInitializationMode",
+        w,
+    )?;
+    plant.read_outputs(w)?;
+    if exchanged {
+        ctrl.take_inputs(Some(&plant), w)?;
+    }
+    check(
+        ctrl.fmu.exitInitializationMode(),
+        "controller: exitInitializationMode",
+        w,
+    )?;
+    ctrl.read_outputs(w)?;
+    if exchanged {
+        plant.take_inputs(Some(&ctrl), w)?;
+    }
+
+    let columns: Vec<String> = std::iter::once("time".to_owned())
+        .chain(plant.column_names().cloned())
+        .chain(ctrl.column_names().cloned())
+        .collect();
+    let record = |t: f64, plant: &Unit, ctrl: &Unit| -> Vec<f64> {
+        std::iter::once(t)
+            .chain(plant.values())
+            .chain(ctrl.values())
+            .collect()
+    };
+    let mut rows = vec![record(0.0, &plant, &ctrl)];
+    for k in 0..steps {
+        let t = f64::from(k) * step;
+        let zero = k == 0 && !exchanged;
+        let plant_out = (!zero).then_some(&plant);
+        ctrl.take_inputs(plant_out, w)?;
+        match coupling {
+            Coupling::GaussSeidel => {
+                check(
+                    ctrl.fmu.doStep(t, step, 1),
+                    &format!("controller: doStep at t = {t} s"),
+                    w,
+                )?;
+                ctrl.read_outputs(w)?;
+                plant.take_inputs(Some(&ctrl), w)?;
+                check(
+                    plant.fmu.doStep(t, step, 1),
+                    &format!("plant: doStep at t = {t} s"),
+                    w,
+                )?;
+            }
+            Coupling::Jacobi => {
+                let ctrl_out = (!zero).then_some(&ctrl);
+                plant.take_inputs(ctrl_out, w)?;
+                check(
+                    ctrl.fmu.doStep(t, step, 1),
+                    &format!("controller: doStep at t = {t} s"),
+                    w,
+                )?;
+                check(
+                    plant.fmu.doStep(t, step, 1),
+                    &format!("plant: doStep at t = {t} s"),
+                    w,
+                )?;
+                ctrl.read_outputs(w)?;
+            }
+        }
+        plant.read_outputs(w)?;
+        rows.push(record(f64::from(k + 1) * step, &plant, &ctrl));
+    }
+    check(ctrl.fmu.terminate(), "controller: terminate", w)?;
+    check(plant.fmu.terminate(), "plant: terminate", w)?;
+    Ok(Trajectory {
+        columns,
+        rows,
+        to_controller,
+        to_plant,
+        warnings,
+    })
+}
