@@ -329,152 +329,317 @@ pub struct ControllerView {
     pub roles: Vec<String>,
 }
 
-/// Assesses one encounter from its samples (time order; at least one).
-#[must_use]
-pub fn assess(
-    target: &str,
-    slot: u32,
-    samples: &[EncounterSample],
-    controller: Option<&ControllerView>,
-    p: &ScoringParams,
-) -> Option<EncounterReport> {
-    samples.first()?;
-    let range = |s: &EncounterSample| (s.target[0] - s.own[0]).hypot(s.target[1] - s.own[1]);
-    let (i_cpa, r_cpa) = samples
-        .iter()
-        .enumerate()
-        .map(|(i, s)| (i, range(s)))
-        .filter(|(_, r)| r.is_finite())
-        .min_by(|a, b| a.1.total_cmp(&b.1))?;
-    let cpa = samples[i_cpa];
-    let own_p = [cpa.own[0], cpa.own[1]];
-    let tgt_p = [cpa.target[0], cpa.target[1]];
-    let beta_cpa = relative_bearing(own_p, cpa.own[2], tgt_p).to_degrees();
-    let alpha_cpa = relative_bearing(tgt_p, cpa.target[2], own_p).to_degrees();
+/// The heading changes and the first action from the tow's detection up to a sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Window {
+    /// Own heading when the tow detected the target, rad.
+    base_psi: f64,
+    /// Largest heading change to starboard so far, deg.
+    stbd: f64,
+    /// Largest heading change to port so far, deg.
+    port: f64,
+    was_altered: bool,
+    /// The first action: its time, what it was, and the range then.
+    action: Option<(f64, &'static str, f64)>,
+}
 
-    // Controller's situation: the first definite one (the held situation), every distinct
-    // one in order, and the role that came with the first definite one.
-    let (mut situation, mut role, mut reported) = (None, None, Vec::<String>::new());
-    if let Some(c) = controller {
-        for (k, &code) in c.situation_codes.iter().enumerate() {
-            if let Some(s) = Situation::from_code(code) {
-                if reported.last().map(String::as_str) != Some(s.name()) {
-                    reported.push(s.name().to_owned());
-                }
-                if situation.is_none() && s != Situation::Safe {
-                    situation = Some(s);
-                    role = c.roles.get(k).cloned();
-                }
-            }
+/// The closest point of approach so far, with the window as it was then.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Cpa {
+    index: usize,
+    range: f64,
+    sample: EncounterSample,
+    window: Option<Window>,
+}
+
+/// The assessment of one encounter fed one sample at a time (O(1) state, for a plant log
+/// streamed by): every quantity [`assess`] needs is a first event (detection by the ship,
+/// by the tow), a running extreme (the CPA), or a prefix of the window from the tow's
+/// detection, whose state is kept as it was at the CPA so far.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EncounterTracker {
+    p: ScoringParams,
+    samples: usize,
+    /// First sample with the ship within `r_detect`.
+    detect: Option<EncounterSample>,
+    /// First sample with the ship or a tug within `r_detect` (the window's start).
+    detect_tow: Option<EncounterSample>,
+    window: Option<Window>,
+    cpa: Option<Cpa>,
+}
+
+fn range_of(s: &EncounterSample) -> f64 {
+    (s.target[0] - s.own[0]).hypot(s.target[1] - s.own[1])
+}
+
+impl EncounterTracker {
+    /// A tracker with the parameters `p`.
+    #[must_use]
+    pub fn new(p: ScoringParams) -> Self {
+        EncounterTracker {
+            p,
+            samples: 0,
+            detect: None,
+            detect_tow: None,
+            window: None,
+            cpa: None,
         }
     }
 
-    let i_det = samples[..=i_cpa]
-        .iter()
-        .position(|s| range(s) < p.r_detect_m);
-    let geometric = i_det.map(|i| {
-        let s = samples[i];
-        let beta = relative_bearing([s.own[0], s.own[1]], s.own[2], [s.target[0], s.target[1]]);
-        let alpha = relative_bearing(
-            [s.target[0], s.target[1]],
-            s.target[2],
-            [s.own[0], s.own[1]],
+    /// Samples pushed.
+    #[must_use]
+    pub fn samples(&self) -> usize {
+        self.samples
+    }
+
+    /// The next sample (time order).
+    pub fn push(&mut self, s: EncounterSample) {
+        let index = self.samples;
+        self.samples += 1;
+        let range = range_of(&s);
+        if self.detect.is_none() && range < self.p.r_detect_m {
+            self.detect = Some(s);
+        }
+        // The tow's detection is the first sample with the ship (range) or the nearest
+        // vessel (tow_range) within r_detect.
+        if self.window.is_none() && (range < self.p.r_detect_m || s.tow_range < self.p.r_detect_m) {
+            self.detect_tow = Some(s);
+            self.window = Some(Window {
+                base_psi: s.own[2],
+                stbd: 0.0,
+                port: 0.0,
+                was_altered: s.altered.unwrap_or(false),
+                action: None,
+            });
+        }
+        if let Some(w) = &mut self.window {
+            let dev = wrap(s.own[2] - w.base_psi).to_degrees();
+            w.stbd = w.stbd.max(dev);
+            w.port = w.port.max(-dev);
+            let altered = s.altered.unwrap_or(false);
+            if w.action.is_none() {
+                if altered && !w.was_altered {
+                    w.action = Some((
+                        s.t,
+                        "reference altered (waypoint altering, eq. (10)-(11))",
+                        range,
+                    ));
+                } else if dev.abs() >= self.p.action_threshold_deg {
+                    w.action = Some((
+                        s.t,
+                        if dev > 0.0 {
+                            "heading change to starboard"
+                        } else {
+                            "heading change to port"
+                        },
+                        range,
+                    ));
+                }
+            }
+            w.was_altered = altered;
+        }
+        if range.is_finite() && self.cpa.is_none_or(|c| range < c.range) {
+            self.cpa = Some(Cpa {
+                index,
+                range,
+                sample: s,
+                window: self.window,
+            });
+        }
+    }
+
+    /// The assessment of the samples so far (`None` without a sample of finite range).
+    #[must_use]
+    pub fn finish(
+        &self,
+        target: &str,
+        slot: u32,
+        controller: Option<&ControllerView>,
+    ) -> Option<EncounterReport> {
+        let p = &self.p;
+        let cpa_rec = self.cpa?;
+        let cpa = cpa_rec.sample;
+        let r_cpa = cpa_rec.range;
+        let det_ship = self.detect;
+        let (mut report, assessed) = EncounterReport::at_cpa(
+            target,
+            slot,
+            &cpa,
+            r_cpa,
+            det_ship.as_ref(),
+            controller,
+            cpa_rec.index + 1 == self.samples && self.samples > 1,
+            p,
         );
-        classify(beta.to_degrees(), alpha.to_degrees(), s.own[3], s.target[3])
-    });
-    let assessed = situation.or(geometric);
+        let Some(det_ship) = det_ship else {
+            report
+                .reasons
+                .push(format!("never within r_detect = {:.2} m", p.r_detect_m));
+            return Some(report);
+        };
+        report.t_detect_s = Some(det_ship.t);
+        // The tow detects no later than the ship, so its detection is at or before the CPA
+        // too, and the window holds the heading changes from there up to the CPA.
+        let det = self.detect_tow.unwrap_or(det_ship);
+        report.t_detect_tow_s = Some(det.t);
+        let window = cpa_rec.window.unwrap_or(Window {
+            base_psi: det.own[2],
+            stbd: 0.0,
+            port: 0.0,
+            was_altered: false,
+            action: None,
+        });
+        let (stbd, port) = (window.stbd, window.port);
+        report.course_change_starboard_deg = Some(stbd);
+        report.course_change_port_deg = Some(port);
+        report.course_change_deg = Some(if stbd >= port { stbd } else { -port });
+        let action = window.action;
+        let r_manoeuvre = match action {
+            Some((t, what, r)) => {
+                report.t_first_action_s = Some(t);
+                report.first_action = Some(what.to_owned());
+                report.r_first_action_m = Some(r);
+                r
+            }
+            None => r_cpa,
+        };
+        judge(
+            &mut report,
+            assessed,
+            Manoeuvre {
+                r_manoeuvre,
+                stbd,
+                port,
+                speed_change: (cpa.own[3] - det.own[3]) / det.own[3].abs().max(1e-3),
+                acted: action.is_some(),
+            },
+            p,
+        );
+        Some(report)
+    }
+}
 
-    let mut report = EncounterReport {
-        target: target.to_owned(),
-        slot,
-        situation: situation.map(|s| s.name().to_owned()),
-        role,
-        situations_reported: reported,
-        situation_geometric: geometric.map(|s| s.name().to_owned()),
-        situation_assessed: assessed.map(|s| s.name().to_owned()),
-        t_detect_s: None,
-        t_detect_tow_s: None,
-        t_first_action_s: None,
-        first_action: None,
-        r_first_action_m: None,
-        course_change_deg: None,
-        course_change_starboard_deg: None,
-        course_change_port_deg: None,
-        t_cpa_s: cpa.t,
-        r_cpa_m: r_cpa,
-        r_cpa_ship_lengths: r_cpa / p.ship_length_m,
-        beta_cpa_deg: beta_cpa,
-        alpha_cpa_deg: alpha_cpa,
-        side: if beta_cpa >= 0.0 { "starboard" } else { "port" }.to_owned(),
-        passed: if alpha_cpa > -25.0 && alpha_cpa < 165.0 {
-            "ahead"
-        } else {
-            "astern"
-        }
-        .to_owned(),
-        cpa_at_end_of_log: i_cpa + 1 == samples.len() && samples.len() > 1,
-        verdict: "no encounter".to_owned(),
-        reasons: Vec::new(),
-        rule: None,
-        score: None,
-        scores: None,
-        params: *p,
-    };
-    let Some(i_det) = i_det else {
-        report
-            .reasons
-            .push(format!("never within r_detect = {:.2} m", p.r_detect_m));
-        return Some(report);
-    };
-    report.t_detect_s = Some(samples[i_det].t);
-    let i_tow = samples[..=i_cpa]
-        .iter()
-        .position(|s| s.tow_range < p.r_detect_m)
-        .map_or(i_det, |i| i.min(i_det));
-    let det = samples[i_tow];
-    report.t_detect_tow_s = Some(det.t);
+impl EncounterReport {
+    /// The report's fields known at the closest point of approach `cpa` (range `r_cpa`):
+    /// bearings, side, passing, the controller's situation and role (the first definite one,
+    /// the held situation, and every distinct one in order) and the geometric classification
+    /// at the ship's detection `det_ship`; with the situation the verdict is assessed for.
+    /// Verdict "no encounter" until [`judge`] runs.
+    #[allow(clippy::too_many_arguments)]
+    fn at_cpa(
+        target: &str,
+        slot: u32,
+        cpa: &EncounterSample,
+        r_cpa: f64,
+        det_ship: Option<&EncounterSample>,
+        controller: Option<&ControllerView>,
+        at_end: bool,
+        p: &ScoringParams,
+    ) -> (Self, Option<Situation>) {
+        let own_p = [cpa.own[0], cpa.own[1]];
+        let tgt_p = [cpa.target[0], cpa.target[1]];
+        let beta_cpa = relative_bearing(own_p, cpa.own[2], tgt_p).to_degrees();
+        let alpha_cpa = relative_bearing(tgt_p, cpa.target[2], own_p).to_degrees();
 
-    // Heading change relative to the heading when the tow detected the target, up to the
-    // CPA.
-    let (mut stbd, mut port) = (0.0f64, 0.0f64);
-    let mut action: Option<(usize, &str)> = None;
-    let altered_at_detection = det.altered.unwrap_or(false);
-    let mut was_altered = altered_at_detection;
-    for (i, s) in samples.iter().enumerate().take(i_cpa + 1).skip(i_tow) {
-        let dev = wrap(s.own[2] - det.own[2]).to_degrees();
-        stbd = stbd.max(dev);
-        port = port.max(-dev);
-        let altered = s.altered.unwrap_or(false);
-        if action.is_none() {
-            if altered && !was_altered {
-                action = Some((i, "reference altered (waypoint altering, eq. (10)-(11))"));
-            } else if dev.abs() >= p.action_threshold_deg {
-                action = Some((
-                    i,
-                    if dev > 0.0 {
-                        "heading change to starboard"
-                    } else {
-                        "heading change to port"
-                    },
-                ));
+        // Controller's situation: the first definite one (the held situation), every
+        // distinct one in order, and the role that came with the first definite one.
+        let (mut situation, mut role, mut reported) = (None, None, Vec::<String>::new());
+        if let Some(c) = controller {
+            for (k, &code) in c.situation_codes.iter().enumerate() {
+                if let Some(s) = Situation::from_code(code) {
+                    if reported.last().map(String::as_str) != Some(s.name()) {
+                        reported.push(s.name().to_owned());
+                    }
+                    if situation.is_none() && s != Situation::Safe {
+                        situation = Some(s);
+                        role = c.roles.get(k).cloned();
+                    }
+                }
             }
         }
-        was_altered = altered;
+
+        let geometric = det_ship.map(|s| {
+            let beta = relative_bearing([s.own[0], s.own[1]], s.own[2], [s.target[0], s.target[1]]);
+            let alpha = relative_bearing(
+                [s.target[0], s.target[1]],
+                s.target[2],
+                [s.own[0], s.own[1]],
+            );
+            classify(beta.to_degrees(), alpha.to_degrees(), s.own[3], s.target[3])
+        });
+        let assessed = situation.or(geometric);
+
+        let report = Self {
+            target: target.to_owned(),
+            slot,
+            situation: situation.map(|s| s.name().to_owned()),
+            role,
+            situations_reported: reported,
+            situation_geometric: geometric.map(|s| s.name().to_owned()),
+            situation_assessed: assessed.map(|s| s.name().to_owned()),
+            t_detect_s: None,
+            t_detect_tow_s: None,
+            t_first_action_s: None,
+            first_action: None,
+            r_first_action_m: None,
+            course_change_deg: None,
+            course_change_starboard_deg: None,
+            course_change_port_deg: None,
+            t_cpa_s: cpa.t,
+            r_cpa_m: r_cpa,
+            r_cpa_ship_lengths: r_cpa / p.ship_length_m,
+            beta_cpa_deg: beta_cpa,
+            alpha_cpa_deg: alpha_cpa,
+            side: if beta_cpa >= 0.0 { "starboard" } else { "port" }.to_owned(),
+            passed: if alpha_cpa > -25.0 && alpha_cpa < 165.0 {
+                "ahead"
+            } else {
+                "astern"
+            }
+            .to_owned(),
+            cpa_at_end_of_log: at_end,
+            verdict: "no encounter".to_owned(),
+            reasons: Vec::new(),
+            rule: None,
+            score: None,
+            scores: None,
+            params: *p,
+        };
+        (report, assessed)
     }
-    report.course_change_starboard_deg = Some(stbd);
-    report.course_change_port_deg = Some(port);
-    report.course_change_deg = Some(if stbd >= port { stbd } else { -port });
-    let r_manoeuvre = match action {
-        Some((i, what)) => {
-            report.t_first_action_s = Some(samples[i].t);
-            report.first_action = Some(what.to_owned());
-            let r = range(&samples[i]);
-            report.r_first_action_m = Some(r);
-            r
-        }
-        None => r_cpa,
-    };
-    let speed_change = (cpa.own[3] - det.own[3]) / det.own[3].abs().max(1e-3);
+}
+
+/// What the own ship did in an encounter, as the verdict needs it.
+#[derive(Debug, Clone, Copy)]
+struct Manoeuvre {
+    /// Range at the first action (at the CPA without one), m.
+    r_manoeuvre: f64,
+    /// Largest heading change to starboard and to port between detection and CPA, deg.
+    stbd: f64,
+    port: f64,
+    /// Relative speed change from detection to CPA.
+    speed_change: f64,
+    /// Whether any action was taken between detection and CPA.
+    acted: bool,
+}
+
+/// Scores and verdict of an encounter whose CPA fields (`r_cpa_m`, `alpha_cpa_deg`,
+/// `beta_cpa_deg`) are set: the binary checks of the PSB-MPC evaluator and the rule score
+/// of reference/colregs.md for the `assessed` situation.
+fn judge(
+    report: &mut EncounterReport,
+    assessed: Option<Situation>,
+    m: Manoeuvre,
+    p: &ScoringParams,
+) {
+    let Manoeuvre {
+        r_manoeuvre,
+        stbd,
+        port,
+        speed_change,
+        acted,
+    } = m;
+    let (r_cpa, alpha_cpa, beta_cpa) = (report.r_cpa_m, report.alpha_cpa_deg, report.beta_cpa_deg);
     let sc = scores(
         r_cpa,
         alpha_cpa,
@@ -495,13 +660,14 @@ pub fn assess(
         ));
     }
     let port_turn = port >= p.port_turn_deg && port > stbd;
-    // Rule 16: a give-way vessel takes early and substantial action; none at all between
-    // detection and the CPA is a violation (a small one only lowers the score, P_na).
+    // Rule 16: a give-way vessel takes early and substantial action; none at all
+    // between detection and the CPA is a violation (a small one only lowers the
+    // score, P_na).
     let give_way = matches!(
         assessed,
         Some(Situation::HeadOn | Situation::CrossingGiveWay | Situation::Overtaking)
     );
-    if give_way && action.is_none() {
+    if give_way && !acted {
         reasons.push("no give-way action between detection and the CPA (Rule 16)".to_owned());
     }
     let (rule, score) = match assessed {
@@ -548,13 +714,130 @@ pub fn assess(
     report.rule = rule;
     report.score = score;
     report.scores = Some(sc);
-    Some(report)
+}
+
+/// Assesses one encounter from its samples (time order; at least one): detection, first
+/// action, course change, CPA, verdict and scores (see the module docs). The samples go
+/// through an [`EncounterTracker`], as the streamed plant log's do.
+#[must_use]
+pub fn assess(
+    target: &str,
+    slot: u32,
+    samples: &[EncounterSample],
+    controller: Option<&ControllerView>,
+    p: &ScoringParams,
+) -> Option<EncounterReport> {
+    let mut tracker = EncounterTracker::new(*p);
+    for s in samples {
+        tracker.push(*s);
+    }
+    tracker.finish(target, slot, controller)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use std::f64::consts::PI;
+
+    /// The batch formula (the analyzer's former whole-series `assess`), the reference for
+    /// [`EncounterTracker`].
+    fn assess_batch(
+        target: &str,
+        slot: u32,
+        samples: &[EncounterSample],
+        controller: Option<&ControllerView>,
+        p: &ScoringParams,
+    ) -> Option<EncounterReport> {
+        samples.first()?;
+        let range = |s: &EncounterSample| (s.target[0] - s.own[0]).hypot(s.target[1] - s.own[1]);
+        let (i_cpa, r_cpa) = samples
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (i, range(s)))
+            .filter(|(_, r)| r.is_finite())
+            .min_by(|a, b| a.1.total_cmp(&b.1))?;
+        let cpa = samples[i_cpa];
+        let i_det = samples[..=i_cpa]
+            .iter()
+            .position(|s| range(s) < p.r_detect_m);
+        let (mut report, assessed) = EncounterReport::at_cpa(
+            target,
+            slot,
+            &cpa,
+            r_cpa,
+            i_det.map(|i| &samples[i]),
+            controller,
+            i_cpa + 1 == samples.len() && samples.len() > 1,
+            p,
+        );
+        let Some(i_det) = i_det else {
+            report
+                .reasons
+                .push(format!("never within r_detect = {:.2} m", p.r_detect_m));
+            return Some(report);
+        };
+        report.t_detect_s = Some(samples[i_det].t);
+        let i_tow = samples[..=i_cpa]
+            .iter()
+            .position(|s| s.tow_range < p.r_detect_m)
+            .map_or(i_det, |i| i.min(i_det));
+        let det = samples[i_tow];
+        report.t_detect_tow_s = Some(det.t);
+
+        // Heading change relative to the heading when the tow detected the target, up to the
+        // CPA.
+        let (mut stbd, mut port) = (0.0f64, 0.0f64);
+        let mut action: Option<(usize, &str)> = None;
+        let altered_at_detection = det.altered.unwrap_or(false);
+        let mut was_altered = altered_at_detection;
+        for (i, s) in samples.iter().enumerate().take(i_cpa + 1).skip(i_tow) {
+            let dev = wrap(s.own[2] - det.own[2]).to_degrees();
+            stbd = stbd.max(dev);
+            port = port.max(-dev);
+            let altered = s.altered.unwrap_or(false);
+            if action.is_none() {
+                if altered && !was_altered {
+                    action = Some((i, "reference altered (waypoint altering, eq. (10)-(11))"));
+                } else if dev.abs() >= p.action_threshold_deg {
+                    action = Some((
+                        i,
+                        if dev > 0.0 {
+                            "heading change to starboard"
+                        } else {
+                            "heading change to port"
+                        },
+                    ));
+                }
+            }
+            was_altered = altered;
+        }
+        report.course_change_starboard_deg = Some(stbd);
+        report.course_change_port_deg = Some(port);
+        report.course_change_deg = Some(if stbd >= port { stbd } else { -port });
+        let r_manoeuvre = match action {
+            Some((i, what)) => {
+                report.t_first_action_s = Some(samples[i].t);
+                report.first_action = Some(what.to_owned());
+                let r = range(&samples[i]);
+                report.r_first_action_m = Some(r);
+                r
+            }
+            None => r_cpa,
+        };
+        judge(
+            &mut report,
+            assessed,
+            Manoeuvre {
+                r_manoeuvre,
+                stbd,
+                port,
+                speed_change: (cpa.own[3] - det.own[3]) / det.own[3].abs().max(1e-3),
+                acted: action.is_some(),
+            },
+            p,
+        );
+        Some(report)
+    }
 
     fn params() -> ScoringParams {
         ScoringParams::model_scale(1.255, 1.48, 7.0, 0.25)
@@ -713,5 +996,69 @@ mod tests {
         assert_eq!(r.verdict, "no encounter");
         assert!(r.t_detect_s.is_none());
         assert!(r.r_cpa_m > 7.0);
+    }
+
+    use crate::decimate::tests::rng;
+
+    #[test]
+    fn the_tracker_equals_the_batch_assessment_on_random_encounters() {
+        let p = params();
+        let mut compared = [0usize; 3];
+        for seed in 0..400u64 {
+            let mut r = rng(seed);
+            // A random straight pass with random heading wobble, alterations and tug
+            // ranges; ranges on a coarse grid now and then (ties of the CPA).
+            let n = 1 + (r() * 300.0) as usize;
+            let (x0, y0) = (r() * 30.0 - 5.0, r() * 16.0 - 8.0);
+            let course = r() * 2.0 * PI;
+            let (u, vt) = (0.05 + 0.1 * r(), 0.1 * r());
+            let turn_at = (r() * n as f64) as usize;
+            let turn = (r() - 0.5) * 1.2;
+            let grid = r() < 0.3;
+            let samples: Vec<EncounterSample> = (0..n)
+                .map(|k| {
+                    let t = k as f64 * 0.5;
+                    let psi = if k >= turn_at { turn } else { 0.0 } + 0.05 * (r() - 0.5);
+                    let mut own = [u * t, 0.0, psi, u];
+                    if grid {
+                        own[0] = (own[0] * 2.0).round() / 2.0;
+                    }
+                    let target = [
+                        x0 + vt * t * course.cos(),
+                        y0 + vt * t * course.sin(),
+                        course,
+                        vt,
+                    ];
+                    let range = (target[0] - own[0]).hypot(target[1] - own[1]);
+                    EncounterSample {
+                        t,
+                        own,
+                        target,
+                        altered: if r() < 0.1 { None } else { Some(r() < 0.3) },
+                        tow_range: if r() < 0.2 {
+                            f64::INFINITY
+                        } else {
+                            range - 2.0 * r()
+                        },
+                    }
+                })
+                .collect();
+            let view = ControllerView {
+                situation_codes: (0..5).map(|_| (r() * 8.0) as i32 - 1).collect(),
+                roles: (0..5).map(|k| format!("role {k}")).collect(),
+            };
+            let view = (r() < 0.7).then_some(&view);
+            let a = assess("X", 3, &samples, view, &p);
+            let b = assess_batch("X", 3, &samples, view, &p);
+            assert_eq!(a, b, "seed {seed}");
+            let k = match &a {
+                Some(rep) if rep.t_first_action_s.is_some() => 0,
+                Some(rep) if rep.t_detect_s.is_some() => 1,
+                _ => 2,
+            };
+            compared[k] += 1;
+        }
+        // The cases are all exercised: an action, a detection without one, no encounter.
+        assert!(compared.iter().all(|&c| c > 10), "{compared:?}");
     }
 }

@@ -2,61 +2,234 @@
 //! (log time, ns since simulation time 0), aligned in time by backward as-of joins (the
 //! last row of the right table at or before each left row).
 //!
+//! The controller's frames are built once ([`build_controller`]: the controller log is read
+//! whole, about one row per ten plant steps). The plant's frames are built per batch of
+//! plant steps while the plant log streams by ([`build_plant_batch`]); a batch ends at a
+//! change of log time, and the last row of each right-hand table is carried into the next
+//! batch, so every as-of join gives what it would give on the whole log.
+//!
 //! | frame | rows | columns |
 //! |---|---|---|
 //! | `vessels` | plant steps | `t_ns`, `t_s`, `{ship,tug1,tug2}_{x,y,psi,u,v,r}` (tugs as-of joined onto the ship's times) |
 //! | `towlines` | plant steps | `line{1,2}_{length,angle,tension,tension_cmd,slack,elongation_error}` |
 //! | `inputs` | plant steps | `in_tug{1,2}_{X,Y,N}`, `in_tension_cmd{1,2}` |
-//! | `obstacles` | plant steps x active slots | `slot`, `name`, `kind`, `obs_{x,y,psi,speed,length,width}`, the vessels' poses joined as of the row's time, and the centre distances `d_{ship,tug1,tug2}` |
-//! | `reference`, `command`, `solver`, `colregs` | control samples (`colregs`: x slots) | the controller's topics |
-//! | `controller` | control samples | `solver` with `reference` and `command` joined |
-//! | `timeseries` ([`Frames::timeseries`], in slices) | plant steps | `vessels` with `towlines`, `inputs` and `controller` joined |
+//! | `obstacles` | plant steps x active slots | `slot`, `name`, `kind`, `obs_{x,y,psi,speed,length,width}`, the vessels' poses joined as of the row's time, the centre distances `d_{ship,tug1,tug2}` and the guidance's `altered_effective` |
+//! | `reference`, `command`, `solver` | control samples | the controller's topics |
+//! | `colregs` ([`ControllerFrames::colregs_rows`], in chunks) | control samples x slots | the controller's situation and role per slot |
+//! | `controller` ([`ControllerFrames::controller_rows`], in chunks) | control samples | the longest of `reference`, `solver`, `command` with the others joined |
+//! | `timeseries` ([`PlantBatch::timeseries`]) | plant steps | `vessels` with `towlines`, `inputs` and `controller` joined |
 
 use std::borrow::Cow;
 
 use polars::prelude::*;
 
 use crate::error::{AnalyzerError, Result};
-use crate::read::{ControllerData, PlantData, VesselCols};
+use crate::read::{ColregsCols, ControllerData, PlantData, VesselCols};
 
-/// All tables of a run.
+/// The controller's tables (the whole controller log). The joined `controller` table and
+/// the long `colregs` table are never whole in memory: they are built per window of rows
+/// ([`ControllerFrames::controller_window`], [`ControllerFrames::controller_rows`],
+/// [`ControllerFrames::colregs_rows`]).
 #[derive(Debug, Clone)]
-pub struct Frames {
+pub struct ControllerFrames {
+    /// Guidance references, with `altered_effective`.
+    pub reference: DataFrame,
+    /// COLREGS situations (long form, compact: labels interned).
+    pub colregs: ColregsCols,
+    /// Row order of `colregs` by time (stable; `None`: already in order).
+    colregs_order: Option<Vec<usize>>,
+    /// Commands.
+    pub command: DataFrame,
+    /// Solver reports.
+    pub solver: DataFrame,
+    /// Which of solver (0), command (1), reference (2) is the joined table's base: the
+    /// longest (the last of equals).
+    base: usize,
+}
+
+impl ControllerFrames {
+    fn parts(&self) -> [&DataFrame; 3] {
+        [&self.solver, &self.command, &self.reference]
+    }
+
+    /// Rows of the joined controller table (the solver with the reference and the command
+    /// joined as of its times, or whichever of the three is longest as the base).
+    #[must_use]
+    pub fn controller_height(&self) -> usize {
+        self.parts()[self.base].height()
+    }
+
+    /// `base_rows` (rows of the base table) with the other two joined as of their times.
+    fn joined(&self, base_rows: DataFrame) -> Result<DataFrame> {
+        let (lo, hi) = time_span(&base_rows, "controller")?;
+        let mut df = base_rows;
+        for (k, part) in self.parts().into_iter().enumerate() {
+            if k != self.base {
+                let t = t_slice(part, "controller")?;
+                df = asof(&df, &window(part, &t, lo, hi, "controller")?, "controller")?;
+            }
+        }
+        Ok(df)
+    }
+
+    /// Rows `offset .. offset + len` of the joined controller table.
+    ///
+    /// # Errors
+    /// A polars error (unexpected).
+    pub fn controller_rows(&self, offset: usize, len: usize) -> Result<DataFrame> {
+        let base = self.parts()[self.base];
+        let rows = base.slice(i64::try_from(offset).unwrap_or(i64::MAX), len);
+        self.joined(sorted(rows, "controller")?)
+    }
+
+    /// Rows of the joined controller table an as-of join of plant rows from `lo` to `hi`
+    /// (ns) can match.
+    ///
+    /// # Errors
+    /// A polars error (unexpected).
+    pub fn controller_window(&self, lo: i64, hi: i64) -> Result<DataFrame> {
+        let base = self.parts()[self.base];
+        let t = t_slice(base, "controller")?;
+        self.joined(window(base, &t, lo, hi, "controller")?)
+    }
+
+    fn altered_window(&self, lo: i64, hi: i64) -> Result<DataFrame> {
+        let t = t_slice(&self.reference, "obstacles")?;
+        let rows = window(&self.reference, &t, lo, hi, "obstacles")?;
+        rows.select(["t_ns", "altered_effective"])
+            .map_err(|e| AnalyzerError::frame("obstacles", e))
+    }
+
+    /// Rows of the colregs table.
+    #[must_use]
+    pub fn colregs_height(&self) -> usize {
+        self.colregs.t_ns.len()
+    }
+
+    /// The colregs rows in time order: their indices into [`ControllerFrames::colregs`].
+    pub fn colregs_indices(&self) -> impl Iterator<Item = usize> + '_ {
+        let n = self.colregs_height();
+        (0..n).map(move |i| self.colregs_order.as_ref().map_or(i, |o| o[i]))
+    }
+
+    /// Rows `offset .. offset + len` (time order) of the colregs table: `t_ns`, `slot`,
+    /// `situation`, `role`, `situation_code`, `role_code`.
+    ///
+    /// # Errors
+    /// A polars error (unexpected).
+    pub fn colregs_rows(&self, offset: usize, len: usize) -> Result<DataFrame> {
+        let c = &self.colregs;
+        let rows: Vec<usize> = self.colregs_indices().skip(offset).take(len).collect();
+        let df = DataFrame::new_infer_height(vec![
+            i64_col("t_ns", rows.iter().map(|&i| c.t_ns[i]).collect()),
+            u32_col("slot", rows.iter().map(|&i| c.slot[i]).collect()),
+            str_col(
+                "situation",
+                rows.iter().map(|&i| c.label(c.situation_idx[i])),
+            ),
+            str_col("role", rows.iter().map(|&i| c.label(c.role_idx[i]))),
+            i32_col(
+                "situation_code",
+                rows.iter().map(|&i| c.situation_code[i]).collect(),
+            ),
+            i32_col("role_code", rows.iter().map(|&i| c.role_code[i]).collect()),
+        ])
+        .map_err(|e| AnalyzerError::frame("colregs", e))?;
+        sorted(df, "colregs")
+    }
+}
+
+/// The `t_ns` column as a slice (borrowed when it is one chunk without nulls).
+fn t_slice<'a>(df: &'a DataFrame, table: &str) -> Result<Cow<'a, [i64]>> {
+    let c = df
+        .column("t_ns")
+        .and_then(|c| c.i64())
+        .map_err(|e| AnalyzerError::frame(table, e))?;
+    if let Ok(s) = c.cont_slice() {
+        return Ok(Cow::Borrowed(s));
+    }
+    Ok(Cow::Owned(
+        c.iter().map(|v| v.unwrap_or(i64::MIN)).collect(),
+    ))
+}
+
+/// The rows of `df` (times `t`, sorted) that a backward as-of join of left rows in
+/// `lo ..= hi` can match: from the last time at or before `lo` (all rows of that time) to
+/// the last at or before `hi`. Zero-copy.
+fn window(df: &DataFrame, t: &[i64], lo: i64, hi: i64, table: &str) -> Result<DataFrame> {
+    let j = t.partition_point(|&v| v <= lo);
+    let start = if j == 0 {
+        0
+    } else {
+        let tj = t[j - 1];
+        t.partition_point(|&v| v < tj)
+    };
+    let end = t.partition_point(|&v| v <= hi).max(start);
+    sorted(
+        df.slice(i64::try_from(start).unwrap_or(i64::MAX), end - start),
+        table,
+    )
+}
+
+/// The last row of each right-hand table of the plant's as-of joins, carried from one
+/// batch into the next.
+#[derive(Debug, Clone, Default)]
+pub struct Carry {
+    tug1: Option<DataFrame>,
+    tug2: Option<DataFrame>,
+    line2: Option<DataFrame>,
+    vessels: Option<DataFrame>,
+    towlines: Option<DataFrame>,
+    inputs: Option<DataFrame>,
+}
+
+/// The plant's tables of one batch of plant steps.
+#[derive(Debug, Clone)]
+pub struct PlantBatch {
     /// Vessel states on the ship's time base.
     pub vessels: DataFrame,
     /// Towline states.
     pub towlines: DataFrame,
     /// Plant inputs.
     pub inputs: DataFrame,
-    /// Obstacles (long form) with the vessels' poses and the centre distances.
+    /// Obstacles (long form) with the vessels' poses, the centre distances and the
+    /// guidance's alteration flag.
     pub obstacles: DataFrame,
-    /// Guidance references.
-    pub reference: DataFrame,
-    /// COLREGS situations (long form).
-    pub colregs: DataFrame,
-    /// Commands.
-    pub command: DataFrame,
-    /// Solver reports.
-    pub solver: DataFrame,
-    /// Controller topics on one time base.
-    pub controller: DataFrame,
+    /// `towlines` after the carried row (the right table of the time-series join).
+    towlines_join: DataFrame,
+    /// `inputs` after the carried row.
+    inputs_join: DataFrame,
 }
 
-impl Frames {
-    /// Rows `offset .. offset + len` of the plant-time table: `vessels` with `towlines`,
-    /// `inputs` and `controller` joined as of each step. Built in slices so the joined
-    /// copy of a long run never exists whole.
+impl PlantBatch {
+    /// The plant-time table of the batch: `vessels` with `towlines`, `inputs` and the
+    /// controller's table joined as of each step.
     ///
     /// # Errors
     /// A polars error (unexpected).
-    pub fn timeseries(&self, offset: usize, len: usize) -> Result<DataFrame> {
-        let offset = i64::try_from(offset).unwrap_or(i64::MAX);
-        let base = self.vessels.slice(offset, len);
-        let mut ts = asof(&base, &self.towlines, "timeseries")?;
-        ts = asof(&ts, &self.inputs, "timeseries")?;
-        ts = asof(&ts, &self.controller, "timeseries")?;
+    pub fn timeseries(&self, ctrl: &ControllerFrames) -> Result<DataFrame> {
+        let (lo, hi) = time_span(&self.vessels, "timeseries")?;
+        let mut ts = asof(&self.vessels, &self.towlines_join, "timeseries")?;
+        ts = asof(&ts, &self.inputs_join, "timeseries")?;
+        ts = asof(&ts, &ctrl.controller_window(lo, hi)?, "timeseries")?;
         Ok(ts)
     }
+}
+
+/// First and last `t_ns` of a frame (`(0, -1)` when empty).
+fn time_span(df: &DataFrame, table: &str) -> Result<(i64, i64)> {
+    let t = df
+        .column("t_ns")
+        .and_then(|c| c.i64())
+        .map_err(|e| AnalyzerError::frame(table, e))?;
+    // `ChunkedArray::first` panics on an empty array.
+    if t.is_empty() {
+        return Ok((0, -1));
+    }
+    Ok(match (t.get(0), t.get(t.len() - 1)) {
+        (Some(a), Some(b)) => (a.min(b), a.max(b)),
+        _ => (0, -1),
+    })
 }
 
 // The column constructors take the vectors over; `shrink_to_fit` first, or the spare
@@ -115,12 +288,16 @@ fn opt_str_col<'a>(name: &str, v: impl Iterator<Item = Option<&'a str>>) -> Colu
         .into_column()
 }
 
-/// A frame from columns, sorted by `t_ns` (stable) if it is not already, with the sorted
-/// flag set so as-of joins accept it.
+/// A frame from columns, sorted by `t_ns` (see [`sorted`]).
 fn frame(table: &str, columns: Vec<Column>) -> Result<DataFrame> {
-    let mut df =
-        DataFrame::new_infer_height(columns).map_err(|e| AnalyzerError::frame(table, e))?;
-    let sorted = {
+    let df = DataFrame::new_infer_height(columns).map_err(|e| AnalyzerError::frame(table, e))?;
+    sorted(df, table)
+}
+
+/// `df` sorted by `t_ns` (stable) if it is not already, with the sorted flag set so as-of
+/// joins accept it.
+fn sorted(mut df: DataFrame, table: &str) -> Result<DataFrame> {
+    let is_sorted = {
         let t = df
             .column("t_ns")
             .and_then(|c| c.i64())
@@ -132,7 +309,7 @@ fn frame(table: &str, columns: Vec<Column>) -> Result<DataFrame> {
             ok
         })
     };
-    if !sorted {
+    if !is_sorted {
         df = df
             .sort(
                 ["t_ns"],
@@ -147,6 +324,23 @@ fn frame(table: &str, columns: Vec<Column>) -> Result<DataFrame> {
         }
     }
     DataFrame::new_infer_height(cols).map_err(|e| AnalyzerError::frame(table, e))
+}
+
+/// The carried row (if any) followed by `df`, sorted; the new carry is its last row.
+fn with_carry(carry: &mut Option<DataFrame>, df: DataFrame, table: &str) -> Result<DataFrame> {
+    let joined = match carry.take() {
+        Some(c) if c.height() > 0 => {
+            let mut c = c;
+            c.vstack_mut(&df)
+                .map_err(|e| AnalyzerError::frame(table, e))?;
+            sorted(c, table)?
+        }
+        _ => df,
+    };
+    if joined.height() > 0 {
+        *carry = Some(joined.tail(Some(1)));
+    }
+    Ok(joined)
 }
 
 /// Backward as-of join of `right` onto `left` on `t_ns` (equal times match).
@@ -201,13 +395,17 @@ fn vessel_columns(prefix: &str, v: VesselCols, with_time: bool) -> Vec<Column> {
     cols
 }
 
-/// Builds every frame, taking the columns over (no copy of the plant's vectors). `route`
-/// (origin, waypoints, destination: North, East, heading) tells which references were
-/// really altered (see `altered_effective`).
+/// Builds the plant's frames of one batch, taking the columns over (no copy of the
+/// vectors). `carry` holds the last rows of the previous batch's right-hand tables and is
+/// updated; `ctrl` gives the guidance's alteration flag for the obstacle rows.
 ///
 /// # Errors
 /// A polars error (unexpected; the message names the table).
-pub fn build(plant: PlantData, controller: ControllerData, route: &[[f64; 3]]) -> Result<Frames> {
+pub fn build_plant_batch(
+    plant: PlantData,
+    carry: &mut Carry,
+    ctrl: &ControllerFrames,
+) -> Result<PlantBatch> {
     let PlantData {
         ship,
         tug1,
@@ -218,8 +416,16 @@ pub fn build(plant: PlantData, controller: ControllerData, route: &[[f64; 3]]) -
     } = plant;
 
     let ship_df = frame("vessels", vessel_columns("ship", ship, true))?;
-    let tug1_df = frame("vessels", vessel_columns("tug1", tug1, false))?;
-    let tug2_df = frame("vessels", vessel_columns("tug2", tug2, false))?;
+    let tug1_df = with_carry(
+        &mut carry.tug1,
+        frame("vessels", vessel_columns("tug1", tug1, false))?,
+        "vessels",
+    )?;
+    let tug2_df = with_carry(
+        &mut carry.tug2,
+        frame("vessels", vessel_columns("tug2", tug2, false))?,
+        "vessels",
+    )?;
     let vessels = asof(&asof(&ship_df, &tug1_df, "vessels")?, &tug2_df, "vessels")?;
     drop((ship_df, tug1_df, tug2_df));
 
@@ -239,8 +445,13 @@ pub fn build(plant: PlantData, controller: ControllerData, route: &[[f64; 3]]) -
         c
     };
     let l1_df = frame("towlines", line_cols(1, l1))?;
-    let l2_df = frame("towlines", line_cols(2, l2))?;
+    let l2_df = with_carry(
+        &mut carry.line2,
+        frame("towlines", line_cols(2, l2))?,
+        "towlines",
+    )?;
     let towlines = asof(&l1_df, &l2_df, "towlines")?;
+    drop((l1_df, l2_df));
 
     let [i1x, i1y, i1n] = inputs.tug1;
     let [i2x, i2y, i2n] = inputs.tug2;
@@ -289,16 +500,43 @@ pub fn build(plant: PlantData, controller: ControllerData, route: &[[f64; 3]]) -
         ],
     )?;
     // Only what the distances, collisions and encounters need.
-    let vessel_poses = vessels
+    let vessels_join = with_carry(&mut carry.vessels, vessels.clone(), "obstacles")?;
+    let vessel_poses = vessels_join
         .select([
             "t_ns", "ship_x", "ship_y", "ship_psi", "ship_u", "ship_v", "tug1_x", "tug1_y",
             "tug1_psi", "tug2_x", "tug2_y", "tug2_psi",
         ])
         .map_err(|e| AnalyzerError::frame("obstacles", e))?;
     let joined = asof(&obstacle_df, &vessel_poses, "obstacles")?;
-    drop((obstacle_df, vessel_poses));
+    drop((obstacle_df, vessel_poses, vessels_join));
     let obstacles = with_distances(joined)?;
+    // The guidance's alteration flag beside each obstacle row (for the COLREGS first
+    // action).
+    let (lo, hi) = time_span(&obstacles, "obstacles")?;
+    let obstacles = asof(&obstacles, &ctrl.altered_window(lo, hi)?, "obstacles")?;
 
+    let towlines_join = with_carry(&mut carry.towlines, towlines.clone(), "timeseries")?;
+    let inputs_join = with_carry(&mut carry.inputs, inputs.clone(), "timeseries")?;
+    Ok(PlantBatch {
+        vessels,
+        towlines,
+        inputs,
+        obstacles,
+        towlines_join,
+        inputs_join,
+    })
+}
+
+/// Builds the controller's frames, taking the columns over. `route` (origin, waypoints,
+/// destination: North, East, heading) tells which references were really altered (see
+/// `altered_effective`).
+///
+/// # Errors
+/// A polars error (unexpected; the message names the table).
+pub fn build_controller(
+    controller: ControllerData,
+    route: &[[f64; 3]],
+) -> Result<ControllerFrames> {
     let ControllerData {
         reference,
         colregs,
@@ -335,28 +573,20 @@ pub fn build(plant: PlantData, controller: ControllerData, route: &[[f64; 3]]) -
             f64_col("wp_psi", wpp),
         ],
     )?;
-    // The guidance's alteration flag beside each obstacle row (for the COLREGS first
-    // action).
-    let altered = reference
-        .select(["t_ns", "altered_effective"])
-        .map_err(|e| AnalyzerError::frame("obstacles", e))?;
-    let obstacles = asof(&obstacles, &altered, "obstacles")?;
-    let situation_col = str_col(
-        "situation",
-        colregs.situation_idx.iter().map(|&k| colregs.label(k)),
-    );
-    let role_col = str_col("role", colregs.role_idx.iter().map(|&k| colregs.label(k)));
-    let colregs_df = frame(
-        "colregs",
-        vec![
-            i64_col("t_ns", colregs.t_ns),
-            u32_col("slot", colregs.slot),
-            situation_col,
-            role_col,
-            i32_col("situation_code", colregs.situation_code),
-            i32_col("role_code", colregs.role_code),
-        ],
-    )?;
+    // The colregs rows stay compact; a stable time order if they are not in one.
+    let mut colregs = colregs;
+    let in_order = colregs.t_ns.windows(2).all(|w| w[0] <= w[1]);
+    let colregs_order = (!in_order).then(|| {
+        let mut order: Vec<usize> = (0..colregs.t_ns.len()).collect();
+        order.sort_by_key(|&i| colregs.t_ns[i]);
+        order
+    });
+    colregs.t_ns.shrink_to_fit();
+    colregs.slot.shrink_to_fit();
+    colregs.situation_idx.shrink_to_fit();
+    colregs.role_idx.shrink_to_fit();
+    colregs.situation_code.shrink_to_fit();
+    colregs.role_code.shrink_to_fit();
     let [c1x, c1y, c1n] = command.tug1;
     let [c2x, c2y, c2n] = command.tug2;
     let [ct1, ct2] = command.tension;
@@ -417,25 +647,15 @@ pub fn build(plant: PlantData, controller: ControllerData, route: &[[f64; 3]]) -
     )?;
 
     // The controller's topics on one base: the longest of solver, command, reference.
-    let parts = [&solver_df, &command, &reference];
-    let base_idx = (0..3).max_by_key(|&k| parts[k].height()).unwrap_or(0);
-    let mut controller_df = parts[base_idx].clone();
-    for (k, part) in parts.iter().enumerate() {
-        if k != base_idx {
-            controller_df = asof(&controller_df, part, "controller")?;
-        }
-    }
-
-    Ok(Frames {
-        vessels,
-        towlines,
-        inputs,
-        obstacles,
+    let heights = [solver_df.height(), command.height(), reference.height()];
+    let base = (0..3).max_by_key(|&k| heights[k]).unwrap_or(0);
+    Ok(ControllerFrames {
         reference,
-        colregs: colregs_df,
+        colregs,
+        colregs_order,
         command,
         solver: solver_df,
-        controller: controller_df,
+        base,
     })
 }
 
@@ -539,7 +759,7 @@ pub fn seconds(df: &DataFrame) -> Result<Vec<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::read::{ControllerData, PlantData, ReferenceCols};
+    use crate::read::{ControllerData, ReferenceCols};
 
     #[test]
     fn an_alteration_is_in_effect_only_off_the_route() {
@@ -559,7 +779,7 @@ mod tests {
             reference,
             ..ControllerData::default()
         };
-        let f = build(PlantData::default(), controller, &route).expect("frames");
+        let f = build_controller(controller, &route).expect("frames");
         let eff = bools(&f.reference, "altered_effective").expect("column");
         assert_eq!(eff, vec![Some(false), Some(true), Some(false)]);
     }

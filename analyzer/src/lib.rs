@@ -1,23 +1,28 @@
 //! Analyzer of the towing co-simulation's MCAP logs (docs/logging.md, docs/analyzer.md).
 //!
 //! `analyzer report` reads one run (the plant's and the controller's log, any order) with
-//! a streaming, bounded-memory MCAP reader into polars DataFrames, computes the metrics of
-//! Du, Negenborn, Reppa (2022), section 4.2 (settling time, towline elongation error,
-//! normalised minimum distance eq. (30), ship travel) and the checks added here
-//! (collisions, COLREGS assessment and scoring, command bounds, solver statistics), and
-//! writes `metrics.json`, tables, plots and a report. `analyzer compare` lays several runs
-//! out as the paper's Tables 6 and 7 beside the published figures.
+//! a streaming MCAP reader, computes the metrics of Du, Negenborn, Reppa (2022), section
+//! 4.2 (settling time, towline elongation error, normalised minimum distance eq. (30),
+//! ship travel) and the checks added here (collisions, COLREGS assessment and scoring,
+//! command bounds, solver statistics), and writes `metrics.json`, tables, plots and a
+//! report. The controller log is read whole first; the plant log is then analysed while it
+//! streams by, in batches of plant steps, so memory does not grow with its length.
+//! `analyzer compare` lays several runs out as the paper's Tables 6 and 7 beside the
+//! published figures.
 //!
-//! Modules, in the order of the data flow: [`read`] (MCAP to columns), [`run`] (plant and
-//! controller log together, scenario, bounds), [`frames`] (DataFrames, as-of joins),
-//! [`metrics`], [`colregs`] and [`geometry`] (pure computations), [`analysis`] (frames to
-//! metrics and plot data), [`plots`], [`report`], [`compare`].
+//! Modules, in the order of the data flow: [`read`] (MCAP to messages and columns),
+//! [`run`] (which log is which, the controller's data, scenario, bounds), [`stream`] (the
+//! plant log in batches), [`frames`] (DataFrames, as-of joins), [`metrics`], [`colregs`]
+//! and [`geometry`] (pure computations, each metric as a batch formula and an incremental
+//! tracker), [`decimate`] (plot series of bounded size), [`analysis`] (batches to metrics
+//! and plot data), [`plots`], [`report`], [`compare`].
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod analysis;
 pub mod colregs;
 pub mod compare;
+pub mod decimate;
 pub mod doc;
 pub mod error;
 pub mod frames;
@@ -29,6 +34,7 @@ pub mod progress;
 pub mod read;
 pub mod report;
 pub mod run;
+pub mod stream;
 pub mod synth;
 
 pub use compare::compare;

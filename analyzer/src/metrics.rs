@@ -1,6 +1,11 @@
 //! The metrics of Du, Negenborn, Reppa (2022), section 4.2, and the checks added here,
 //! as pure functions of time series (no I/O, no dataframes), so each can be tested on
 //! synthetic data with a known answer.
+//!
+//! Each metric of the plant log has two forms: the batch formula on whole series (the
+//! definition, e.g. [`settling_time`]) and an incremental tracker with O(1) state fed one
+//! plant step at a time while the log streams by (e.g. [`SettlingTracker`]); the tests
+//! check that both agree on random data.
 
 use std::borrow::Cow;
 
@@ -117,11 +122,18 @@ pub fn settling_time(
 ) -> Option<f64> {
     let n = t.len().min(ship.len());
     let ok = |i: usize| {
-        dist([ship.x[i], ship.y[i]], [destination[0], destination[1]]) < c.position_m
-            && wrap(ship.psi[i] - destination[2]).abs() < c.heading_rad
-            && ship.u[i].abs() < c.speed_m_s
-            && ship.v[i].abs() < c.speed_m_s
-            && ship.r[i].abs() < c.yaw_rate_rad_s
+        settled(
+            [
+                ship.x[i],
+                ship.y[i],
+                ship.psi[i],
+                ship.u[i],
+                ship.v[i],
+                ship.r[i],
+            ],
+            destination,
+            c,
+        )
     };
     let mut first = None;
     for i in (0..n).rev() {
@@ -132,6 +144,130 @@ pub fn settling_time(
         }
     }
     first.map(|i| t[i])
+}
+
+/// True when the ship's state `[x, y, psi, u, v, r]` meets the settling criteria `c` for
+/// `destination` (Du et al. 2022, section 4.2.3); a value that is not finite does not.
+#[must_use]
+pub fn settled(state: [f64; 6], destination: [f64; 3], c: SettleCriteria) -> bool {
+    let [x, y, psi, u, v, r] = state;
+    dist([x, y], [destination[0], destination[1]]) < c.position_m
+        && wrap(psi - destination[2]).abs() < c.heading_rad
+        && u.abs() < c.speed_m_s
+        && v.abs() < c.speed_m_s
+        && r.abs() < c.yaw_rate_rad_s
+}
+
+/// [`settling_time`] (Du et al. 2022, section 4.2.3) one sample at a time: the time since
+/// which every sample met the criteria (O(1) state: reset by each sample that does not).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SettlingTracker {
+    since: Option<f64>,
+}
+
+impl SettlingTracker {
+    /// The sample at `t` met the criteria (`ok`) or not.
+    pub fn push(&mut self, t: f64, ok: bool) {
+        if !ok {
+            self.since = None;
+        } else if self.since.is_none() {
+            self.since = Some(t);
+        }
+    }
+
+    /// The settling time so far (`None` if the last sample did not meet the criteria).
+    #[must_use]
+    pub fn value(&self) -> Option<f64> {
+        self.since
+    }
+}
+
+/// The largest value and its time, one sample at a time; the last of equal maxima wins, as
+/// `Iterator::max_by` (used for [`max_elongation_error`], Du et al. 2022, section 4.2.3).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ArgMax {
+    best: Option<(f64, f64)>,
+}
+
+impl ArgMax {
+    /// A sample `value` at `t` (the caller leaves out what the batch formula filters).
+    pub fn push(&mut self, value: f64, t: f64) {
+        if self
+            .best
+            .is_none_or(|(b, _)| value.total_cmp(&b) != std::cmp::Ordering::Less)
+        {
+            self.best = Some((value, t));
+        }
+    }
+
+    /// `(max, t)`.
+    #[must_use]
+    pub fn value(&self) -> Option<(f64, f64)> {
+        self.best
+    }
+}
+
+/// The smallest value and its time, one sample at a time; the first of equal minima wins, as
+/// `Iterator::min_by` (used for [`min_with_time`], the minimum of Du et al. 2022, eq. (30)).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ArgMin {
+    best: Option<(f64, f64)>,
+}
+
+impl ArgMin {
+    /// A sample `value` at `t` (the caller leaves out what the batch formula filters).
+    pub fn push(&mut self, value: f64, t: f64) {
+        if self
+            .best
+            .is_none_or(|(b, _)| value.total_cmp(&b) == std::cmp::Ordering::Less)
+        {
+            self.best = Some((value, t));
+        }
+    }
+
+    /// `(min, t)`.
+    #[must_use]
+    pub fn value(&self) -> Option<(f64, f64)> {
+        self.best
+    }
+}
+
+/// [`travel`] (the ship's total travelling distance, Du et al. 2022, section 4.2.3) one
+/// position at a time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TravelTracker {
+    prev: Option<(f64, f64)>,
+    sum: f64,
+}
+
+impl Default for TravelTracker {
+    fn default() -> Self {
+        // `Iterator::sum` of f64 starts at -0.0: the same additions in the same order give
+        // the same bits.
+        TravelTracker {
+            prev: None,
+            sum: -0.0,
+        }
+    }
+}
+
+impl TravelTracker {
+    /// The next position (North, East), m.
+    pub fn push(&mut self, x: f64, y: f64) {
+        if let Some((px, py)) = self.prev {
+            let d = (x - px).hypot(y - py);
+            if d.is_finite() {
+                self.sum += d;
+            }
+        }
+        self.prev = Some((x, y));
+    }
+
+    /// Length of the polyline so far, m.
+    #[must_use]
+    pub fn value(&self) -> f64 {
+        self.sum
+    }
 }
 
 /// Largest relative elongation error `|l - l_tow| / l_tow` (Du et al. 2022, section
@@ -210,6 +346,56 @@ pub fn overlap_events(t: &[f64], overlap: &[bool], a: &str, b: &str) -> Vec<Coll
     events
 }
 
+/// [`overlap_events`] one sample at a time, for one pair.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OverlapTracker {
+    a: String,
+    b: String,
+    current: Option<CollisionEvent>,
+    events: Vec<CollisionEvent>,
+}
+
+impl OverlapTracker {
+    /// The tracker of the pair `a`, `b`.
+    #[must_use]
+    pub fn new(a: &str, b: &str) -> Self {
+        OverlapTracker {
+            a: a.to_owned(),
+            b: b.to_owned(),
+            current: None,
+            events: Vec::new(),
+        }
+    }
+
+    /// The sample at `t` overlaps or not.
+    pub fn push(&mut self, t: f64, overlap: bool) {
+        match (&mut self.current, overlap) {
+            (Some(e), true) => {
+                e.t_end_s = t;
+                e.samples += 1;
+            }
+            (None, true) => {
+                self.current = Some(CollisionEvent {
+                    a: self.a.clone(),
+                    b: self.b.clone(),
+                    t_start_s: t,
+                    t_end_s: t,
+                    samples: 1,
+                });
+            }
+            (Some(_), false) => self.events.extend(self.current.take()),
+            (None, false) => {}
+        }
+    }
+
+    /// The events, the one still running at the end included.
+    #[must_use]
+    pub fn finish(mut self) -> Vec<CollisionEvent> {
+        self.events.extend(self.current.take());
+        self.events
+    }
+}
+
 /// Violations of one bound.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Default)]
 pub struct Violations {
@@ -224,8 +410,20 @@ pub struct Violations {
 }
 
 impl Violations {
-    fn check(&mut self, t: f64, magnitude: f64, bound: f64) {
+    /// Checks `magnitude` at `t` against `bound`.
+    pub fn check(&mut self, t: f64, magnitude: f64, bound: f64) {
         self.check_excess(t, magnitude - bound, bound);
+    }
+
+    /// The violations of `self` and then `next`, as if checked in that order.
+    #[must_use]
+    pub fn then(self, next: Violations) -> Violations {
+        Violations {
+            count: self.count + next.count,
+            checked: self.checked + next.checked,
+            worst_excess: self.worst_excess.max(next.worst_excess),
+            first_t_s: self.first_t_s.or(next.first_t_s),
+        }
     }
 
     fn check_excess(&mut self, t: f64, excess: f64, bound: f64) {
@@ -343,6 +541,59 @@ pub fn check_bounds(
         + rep.tug_thrust_command.count
         + rep.tug_thrust_input.count;
     rep
+}
+
+impl BoundReport {
+    /// The report with `inputs` as the received thrusts' check, the total updated.
+    #[must_use]
+    pub fn with_inputs(mut self, inputs: Violations) -> Self {
+        self.tug_thrust_input = inputs;
+        self.total = self.tension.count
+            + self.tension_rate.count
+            + self.towing_angle.count
+            + self.towing_angle_rate.count
+            + self.tug_thrust_command.count
+            + self.tug_thrust_input.count;
+        self
+    }
+}
+
+/// The check of the plant's received thrusts of [`check_bounds`] against the thrust limits
+/// (Du et al. 2022, Table 2; eq. (17)-(21)), one plant step at a time (per tug and
+/// component, merged in the batch check's order).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct InputBoundCheck {
+    per: [[Violations; 3]; 2],
+    limits: [f64; 3],
+}
+
+impl InputBoundCheck {
+    /// Checks against `bounds.max_thrust`.
+    #[must_use]
+    pub fn new(bounds: &Bounds) -> Self {
+        InputBoundCheck {
+            per: Default::default(),
+            limits: bounds.max_thrust,
+        }
+    }
+
+    /// The thrusts of tug 1 and tug 2 (surge N, sway N, yaw N m) received at `t`.
+    pub fn push(&mut self, t: f64, thrust: [[f64; 3]; 2]) {
+        for (tug, values) in thrust.iter().enumerate() {
+            for (k, v) in values.iter().enumerate() {
+                self.per[tug][k].check(t, v.abs(), self.limits[k]);
+            }
+        }
+    }
+
+    /// The violations of every component.
+    #[must_use]
+    pub fn result(&self) -> Violations {
+        self.per
+            .iter()
+            .flatten()
+            .fold(Violations::default(), |acc, v| acc.then(*v))
+    }
 }
 
 /// Rates of change per second between consecutive samples (`NaN` first), for the plots.
@@ -487,5 +738,102 @@ mod tests {
             thrust: [[&z, &z, &z], [&z, &z, &z]],
         };
         assert_eq!(check_bounds(Some(cmd), None, &Bounds::default()).total, 0);
+    }
+
+    use crate::decimate::tests::rng;
+
+    #[test]
+    fn incremental_metrics_equal_the_batch_formulas_on_random_data() {
+        for seed in 0..200u64 {
+            let mut r = rng(seed);
+            let n = (r() * 400.0) as usize;
+            let t: Vec<f64> = (0..n).map(|i| i as f64 * 0.1).collect();
+            // Values on a coarse grid (ties), with NaN now and then.
+            let mut val = |scale: f64| {
+                if r() < 0.03 {
+                    f64::NAN
+                } else {
+                    (r() * 8.0).floor() * scale
+                }
+            };
+            // Near the destination (0, 0, 0), mostly inside the criteria.
+            let rows: Vec<[f64; 6]> = (0..n)
+                .map(|_| {
+                    [
+                        val(0.1),
+                        val(0.1),
+                        val(0.01),
+                        val(0.002),
+                        val(0.002),
+                        val(0.002),
+                    ]
+                })
+                .collect();
+            let ship = track(n, |i| rows[i]);
+            let c = SettleCriteria::paper(1.255);
+            let dest = [0.0, 0.0, 0.0];
+            let mut settle = SettlingTracker::default();
+            let mut trav = TravelTracker::default();
+            let mut emax = ArgMax::default();
+            let mut dmin = ArgMin::default();
+            let mut ov = OverlapTracker::new("ship", "a");
+            let flags: Vec<bool> = ship.x.iter().map(|x| *x < 0.35).collect();
+            for i in 0..n {
+                let s = [
+                    ship.x[i],
+                    ship.y[i],
+                    ship.psi[i],
+                    ship.u[i],
+                    ship.v[i],
+                    ship.r[i],
+                ];
+                settle.push(t[i], settled(s, dest, c));
+                trav.push(ship.x[i], ship.y[i]);
+                if ship.y[i].is_finite() {
+                    emax.push((ship.y[i] - 0.3).abs() / 0.3, t[i]);
+                    dmin.push(ship.y[i], t[i]);
+                }
+                ov.push(t[i], flags[i]);
+            }
+            assert_eq!(
+                settle.value(),
+                settling_time(&t, &ship, dest, c),
+                "seed {seed}"
+            );
+            assert_eq!(trav.value().to_bits(), travel(&ship.x, &ship.y).to_bits());
+            assert_eq!(emax.value(), max_elongation_error(&t, &ship.y, 0.3));
+            assert_eq!(dmin.value(), min_with_time(&t, &ship.y));
+            assert_eq!(ov.finish(), overlap_events(&t, &flags, "ship", "a"));
+        }
+    }
+
+    #[test]
+    fn input_check_per_step_equals_the_batch_check() {
+        for seed in 0..100u64 {
+            let mut r = rng(seed);
+            let n = (r() * 300.0) as usize;
+            let t: Vec<f64> = (0..n).map(|i| i as f64 * 0.1).collect();
+            let cols: Vec<Vec<f64>> = (0..6)
+                .map(|_| (0..n).map(|_| (r() - 0.5) * 22.0).collect())
+                .collect();
+            let mut inc = InputBoundCheck::new(&Bounds::default());
+            for i in 0..n {
+                inc.push(
+                    t[i],
+                    [
+                        [cols[0][i], cols[1][i], cols[2][i]],
+                        [cols[3][i], cols[4][i], cols[5][i]],
+                    ],
+                );
+            }
+            let thrust = [
+                [cols[0].as_slice(), &cols[1], &cols[2]],
+                [cols[3].as_slice(), &cols[4], &cols[5]],
+            ];
+            let batch = check_bounds(None, Some((&t, thrust)), &Bounds::default());
+            assert_eq!(inc.result(), batch.tug_thrust_input, "seed {seed}");
+            let merged = BoundReport::default().with_inputs(inc.result());
+            assert_eq!(merged, batch);
+        }
     }
 }

@@ -11,10 +11,9 @@ use std::sync::OnceLock;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::analysis::{PlotData, TowingSeries};
+use crate::analysis::PlotData;
 use crate::error::{AnalyzerError, Result};
 use crate::geometry::{body_to_ned, circle, ellipse, hull_outline};
-use crate::metrics::rates;
 
 /// DejaVu Sans (Bitstream Vera license, `assets/DejaVuSans-LICENSE.txt`).
 static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
@@ -108,15 +107,10 @@ struct Panel {
     bounds: Vec<(f64, String)>,
 }
 
-/// Keeps a line under [`MAX_POINTS`] points: beyond that, the first, min, max and last
-/// point of each bucket, in time order.
-fn decimate(t: &[f64], v: &[f64]) -> Vec<(f64, f64)> {
-    let pts: Vec<(f64, f64)> = t
-        .iter()
-        .zip(v)
-        .filter(|(a, b)| a.is_finite() && b.is_finite())
-        .map(|(&a, &b)| (a, b))
-        .collect();
+/// Keeps a line of finite points under [`MAX_POINTS`] points (the analysis' series, already
+/// bounded by `crate::decimate`): beyond that, the first, min, max and last point of each
+/// bucket, in time order.
+fn decimate_points(pts: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
     if pts.len() <= MAX_POINTS {
         return pts;
     }
@@ -260,14 +254,8 @@ where
     Ok(())
 }
 
-fn x_range(t: &[f64]) -> Range<f64> {
-    let lo = t.iter().copied().find(|v| v.is_finite()).unwrap_or(0.0);
-    let hi = t
-        .iter()
-        .rev()
-        .copied()
-        .find(|v| v.is_finite())
-        .unwrap_or(1.0);
+fn x_range(span: Option<(f64, f64)>) -> Range<f64> {
+    let (lo, hi) = span.unwrap_or((0.0, 1.0));
     if hi > lo {
         lo..hi
     } else {
@@ -275,7 +263,7 @@ fn x_range(t: &[f64]) -> Range<f64> {
     }
 }
 
-fn vessel_lines(d: &PlotData<'_>, f: impl Fn(usize) -> Vec<f64>) -> Vec<Line> {
+fn vessel_lines(d: &PlotData, channel: usize) -> Vec<Line> {
     let styles = [
         ("ship", SHIP, 2, Dash::Solid),
         ("tug 1 (aft)", TUG1, 1, Dash::Dashed),
@@ -286,7 +274,7 @@ fn vessel_lines(d: &PlotData<'_>, f: impl Fn(usize) -> Vec<f64>) -> Vec<Line> {
         .enumerate()
         .map(|(k, (label, color, width, dash))| Line {
             label: (*label).to_owned(),
-            pts: decimate(&d.t, &f(k)),
+            pts: decimate_points(d.states[k][channel].clone()),
             color: *color,
             width: *width,
             dash: *dash,
@@ -294,111 +282,67 @@ fn vessel_lines(d: &PlotData<'_>, f: impl Fn(usize) -> Vec<f64>) -> Vec<Line> {
         .collect()
 }
 
-fn states_panels(d: &PlotData<'_>) -> Vec<Panel> {
-    let v = &d.vessels;
-    let deg = |x: &[f64]| x.iter().map(|a| a.to_degrees()).collect::<Vec<_>>();
-    // Headings unwrapped (no jump at +-180 deg when heading South).
-    let unwrapped = |x: &[f64]| {
-        let mut out = Vec::with_capacity(x.len());
-        let mut prev: Option<f64> = None;
-        for &a in x {
-            let v = match prev {
-                Some(p) if a.is_finite() => p + crate::geometry::wrap(a - p),
-                _ => a,
-            };
-            if v.is_finite() {
-                prev = Some(v);
-            }
-            out.push(v.to_degrees());
-        }
-        out
+fn states_panels(d: &PlotData) -> Vec<Panel> {
+    // The analysis gives psi unwrapped (no jump at +-180 deg when heading South) and in
+    // deg, r in deg/s.
+    let panel = |title: &str, y_desc: &str, channel: usize| Panel {
+        title: title.into(),
+        y_desc: y_desc.into(),
+        lines: vessel_lines(d, channel),
+        bounds: vec![],
     };
     vec![
-        Panel {
-            title: "x (North)".into(),
-            y_desc: "x (m)".into(),
-            lines: vessel_lines(d, |k| v[k].x.to_vec()),
-            bounds: vec![],
-        },
-        Panel {
-            title: "y (East)".into(),
-            y_desc: "y (m)".into(),
-            lines: vessel_lines(d, |k| v[k].y.to_vec()),
-            bounds: vec![],
-        },
-        Panel {
-            title: "heading psi".into(),
-            y_desc: "psi (deg)".into(),
-            lines: vessel_lines(d, |k| unwrapped(&v[k].psi)),
-            bounds: vec![],
-        },
-        Panel {
-            title: "surge u".into(),
-            y_desc: "u (m/s)".into(),
-            lines: vessel_lines(d, |k| v[k].u.to_vec()),
-            bounds: vec![],
-        },
-        Panel {
-            title: "sway v".into(),
-            y_desc: "v (m/s)".into(),
-            lines: vessel_lines(d, |k| v[k].v.to_vec()),
-            bounds: vec![],
-        },
-        Panel {
-            title: "yaw rate r".into(),
-            y_desc: "r (deg/s)".into(),
-            lines: vessel_lines(d, |k| deg(&v[k].r)),
-            bounds: vec![],
-        },
+        panel("x (North)", "x (m)", 0),
+        panel("y (East)", "y (m)", 1),
+        panel("heading psi", "psi (deg)", 2),
+        panel("surge u", "u (m/s)", 3),
+        panel("sway v", "v (m/s)", 4),
+        panel("yaw rate r", "r (deg/s)", 5),
     ]
 }
 
 /// The actual (plant, not for rates) and commanded lines of one towing channel of
-/// `line`, its values (or their rates) taken from a series by `values`.
+/// `line`.
 fn towing_lines(
-    d: &PlotData<'_>,
     line: usize,
     rate: bool,
-    values: impl Fn(&TowingSeries<'_>) -> Vec<f64>,
+    actual: &[(f64, f64)],
+    commanded: Option<&[(f64, f64)]>,
 ) -> Vec<Line> {
-    let series = |s: &TowingSeries<'_>, label: &str, color: RGBColor, width: u32| -> Line {
-        let v = values(s);
-        let v = if rate { rates(&s.t, &v) } else { v };
-        Line {
-            label: label.to_owned(),
-            pts: decimate(&s.t, &v),
-            color,
-            width,
-            dash: Dash::Solid,
-        }
-    };
     let mut lines = Vec::new();
     if !rate {
-        lines.push(series(
-            &d.actual,
-            "actual (plant)",
-            RGBColor(150, 150, 150),
-            1,
-        ));
+        lines.push(Line {
+            label: "actual (plant)".to_owned(),
+            pts: decimate_points(actual.to_vec()),
+            color: RGBColor(150, 150, 150),
+            width: 1,
+            dash: Dash::Solid,
+        });
     }
-    if let Some(c) = d.command.as_ref() {
-        lines.push(series(
-            c,
-            "commanded",
-            if line == 0 { TUG1 } else { TUG2 },
-            2,
-        ));
+    if let Some(c) = commanded {
+        lines.push(Line {
+            label: "commanded".to_owned(),
+            pts: decimate_points(c.to_vec()),
+            color: if line == 0 { TUG1 } else { TUG2 },
+            width: 2,
+            dash: Dash::Solid,
+        });
     }
     lines
 }
 
-fn towing_panels(d: &PlotData<'_>, rate: bool) -> Vec<Panel> {
+fn towing_panels(d: &PlotData, rate: bool) -> Vec<Panel> {
     let b = &d.bounds;
     let mut panels = Vec::new();
     for line in 0..2 {
-        let lines = towing_lines(d, line, rate, |s| {
-            s.angle[line].iter().map(|a| a.to_degrees()).collect()
+        let commanded = d.command.as_ref().map(|c| {
+            if rate {
+                c.angle_rate_deg[line].as_slice()
+            } else {
+                c.angle_deg[line].as_slice()
+            }
         });
+        let lines = towing_lines(line, rate, &d.actual.angle_deg[line], commanded);
         let (lim, unit) = if rate {
             (b.angle_rate_rad_per_s.to_degrees(), "deg/s")
         } else {
@@ -423,7 +367,14 @@ fn towing_panels(d: &PlotData<'_>, rate: bool) -> Vec<Panel> {
         });
     }
     for line in 0..2 {
-        let lines = towing_lines(d, line, rate, |s| s.tension[line].to_vec());
+        let commanded = d.command.as_ref().map(|c| {
+            if rate {
+                c.tension_rate[line].as_slice()
+            } else {
+                c.tension[line].as_slice()
+            }
+        });
+        let lines = towing_lines(line, rate, &d.actual.tension[line], commanded);
         let bounds = if rate {
             let r = b.tension_rate_n_per_s;
             vec![(r, format!("+{r} N/s")), (-r, format!("-{r} N/s"))]
@@ -451,7 +402,7 @@ fn towing_panels(d: &PlotData<'_>, rate: bool) -> Vec<Panel> {
     panels
 }
 
-fn distance_panels(d: &PlotData<'_>) -> Vec<Panel> {
+fn distance_panels(d: &PlotData) -> Vec<Panel> {
     d.obstacles
         .iter()
         .map(|o| {
@@ -465,7 +416,7 @@ fn distance_panels(d: &PlotData<'_>) -> Vec<Panel> {
                 .enumerate()
                 .map(|(k, (label, color, width, dash))| Line {
                     label: (*label).to_owned(),
-                    pts: decimate(&o.t, &o.distance[k]),
+                    pts: decimate_points(o.distance[k].clone()),
                     color: *color,
                     width: *width,
                     dash: *dash,
@@ -493,94 +444,58 @@ fn distance_panels(d: &PlotData<'_>) -> Vec<Panel> {
         .collect()
 }
 
-fn admm_panels(d: &PlotData<'_>) -> Vec<Panel> {
+fn admm_panels(d: &PlotData) -> Vec<Panel> {
     let Some(s) = &d.solver else {
         return Vec::new();
     };
-    let log = |v: &[f64]| {
-        v.iter()
-            .map(|x| if *x > 0.0 { x.log10() } else { f64::NAN })
-            .collect::<Vec<_>>()
+    let line = |label: &str, pts: &[(f64, f64)], color: RGBColor, dash: Dash| Line {
+        label: label.into(),
+        pts: decimate_points(pts.to_vec()),
+        color,
+        width: 1,
+        dash,
     };
     vec![
         Panel {
             title: "ADMM iterations per sample".into(),
             y_desc: "iterations".into(),
-            lines: vec![Line {
-                label: String::new(),
-                pts: decimate(&s.t, &s.iterations),
-                color: TUG2,
-                width: 1,
-                dash: Dash::Solid,
-            }],
+            lines: vec![line("", &s.iterations, TUG2, Dash::Solid)],
             bounds: vec![],
         },
         Panel {
             title: "last residuals (eq. (29))".into(),
             y_desc: "log10 residual".into(),
             lines: vec![
-                Line {
-                    label: "primal, tug 1".into(),
-                    pts: decimate(&s.t, &log(&s.r_pri[0])),
-                    color: TUG1,
-                    width: 1,
-                    dash: Dash::Solid,
-                },
-                Line {
-                    label: "primal, tug 2".into(),
-                    pts: decimate(&s.t, &log(&s.r_pri[1])),
-                    color: TUG2,
-                    width: 1,
-                    dash: Dash::Solid,
-                },
-                Line {
-                    label: "dual, tug 1".into(),
-                    pts: decimate(&s.t, &log(&s.r_dual[0])),
-                    color: TUG1,
-                    width: 1,
-                    dash: Dash::Dotted,
-                },
-                Line {
-                    label: "dual, tug 2".into(),
-                    pts: decimate(&s.t, &log(&s.r_dual[1])),
-                    color: TUG2,
-                    width: 1,
-                    dash: Dash::Dotted,
-                },
+                line("primal, tug 1", &s.log_r_pri[0], TUG1, Dash::Solid),
+                line("primal, tug 2", &s.log_r_pri[1], TUG2, Dash::Solid),
+                line("dual, tug 1", &s.log_r_dual[0], TUG1, Dash::Dotted),
+                line("dual, tug 2", &s.log_r_dual[1], TUG2, Dash::Dotted),
             ],
             bounds: vec![],
         },
     ]
 }
 
-fn draw_histogram<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, d: &PlotData<'_>) -> DrawResult
+fn draw_histogram<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, d: &PlotData) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
     root.fill(&WHITE)?;
-    let ms: Vec<f64> = d
+    let hist = d
         .solver
         .as_ref()
-        .map(|s| {
-            s.compute_ms
-                .iter()
-                .copied()
-                .filter(|v| v.is_finite())
-                .collect()
-        })
-        .unwrap_or_default();
-    let hi = ms.iter().copied().fold(0.0f64, f64::max).max(1e-3) * 1.02;
-    let bins = 40usize;
-    let width = hi / bins as f64;
-    let mut counts = vec![0u32; bins];
-    for v in &ms {
-        let k = ((v / width) as usize).min(bins - 1);
-        counts[k] += 1;
-    }
+        .map(|s| s.compute_time.clone())
+        .unwrap_or_else(|| crate::analysis::Histogram::new(&[], 40));
+    let hi = hist.hi;
+    let width = hi / hist.counts.len().max(1) as f64;
+    let counts = &hist.counts;
     let top = f64::from(counts.iter().copied().max().unwrap_or(1).max(1)) * 1.1;
     let mut chart = ChartBuilder::on(root)
         .caption(
-            format!("computation time per control sample ({} samples)", ms.len()),
+            format!(
+                "computation time per control sample ({} samples)",
+                hist.samples
+            ),
             (FAMILY, 20),
         )
         .margin(12)
@@ -607,22 +522,26 @@ where
 /// Size and ranges of the map: `(size px, East range, North range)`, with the plotting
 /// area's metres per pixel equal on both axes.
 #[must_use]
-pub fn map_layout(d: &PlotData<'_>) -> ((u32, u32), Range<f64>, Range<f64>) {
+pub fn map_layout(d: &PlotData) -> ((u32, u32), Range<f64>, Range<f64>) {
     let mut east: Vec<f64> = Vec::new();
     let mut north: Vec<f64> = Vec::new();
     for p in &d.route {
         north.push(p[0]);
         east.push(p[1]);
     }
-    for v in &d.vessels {
-        north.extend(v.x.iter().copied());
-        east.extend(v.y.iter().copied());
+    for v in &d.states {
+        // Every extreme of x and y is kept in the plot series.
+        north.extend(v[0].iter().map(|p| p.1));
+        east.extend(v[1].iter().map(|p| p.1));
     }
     for o in &d.obstacles {
         // Static hazards always; target ships only where they come near the ship, so a
         // target's long run-in does not shrink the tow to a line.
         for i in 0..o.x.len() {
-            let near = o.distance[0].get(i).is_some_and(|d| *d < MAP_TARGET_RANGE);
+            let near = o
+                .ship_distance
+                .get(i)
+                .is_some_and(|d| *d < MAP_TARGET_RANGE);
             if o.kind != 2 || near {
                 north.push(o.x[i]);
                 east.push(o.y[i]);
@@ -677,7 +596,7 @@ fn en(p: [f64; 2]) -> (f64, f64) {
 
 fn draw_map<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
-    d: &PlotData<'_>,
+    d: &PlotData,
     er: Range<f64>,
     nr: Range<f64>,
 ) -> DrawResult
@@ -760,8 +679,8 @@ where
     }
 
     // Target ships: tracks, and outlines at the sampled times when active.
-    let samples = sample_indices(&d.t, 10);
-    let sample_times: Vec<f64> = samples.iter().map(|&i| d.t[i]).collect();
+    let samples = sample_indices(&d.poses.t, 10);
+    let sample_times: Vec<f64> = samples.iter().map(|&i| d.poses.t[i]).collect();
     let mut target_legend = false;
     for o in d.obstacles.iter().filter(|o| o.kind == 2) {
         let track: Vec<(f64, f64)> = o.x.iter().zip(&o.y).map(|(&x, &y)| (y, x)).collect();
@@ -780,7 +699,8 @@ where
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], TARGET));
             target_legend = true;
         }
-        // The track may be thinned (analysis::PLOT_ROWS): accept the nearest kept row.
+        // The track may be thinned (StreamOptions::track_rows): accept the nearest kept
+        // row.
         let spacing = match (o.t.first(), o.t.last()) {
             (Some(a), Some(b)) if o.t.len() > 1 => (b - a) / (o.t.len() - 1) as f64,
             _ => 0.0,
@@ -820,9 +740,8 @@ where
     let colors = [SHIP, TUG1, TUG2];
     let labels = ["ship", "tug 1 (aft)", "tug 2 (forward)"];
     for k in 0..3 {
-        let v = &d.vessels[k];
-        // decimate() keeps the samples' order, so the track stays a path.
-        let pts = decimate(&v.y, &v.x);
+        // decimate_points() keeps the samples' order, so the track stays a path.
+        let pts = decimate_points(d.tracks[k].clone());
         let color = colors[k];
         chart
             .draw_series(LineSeries::new(
@@ -836,8 +755,8 @@ where
     }
     for &i in &samples {
         let pose = |k: usize| {
-            let v = &d.vessels[k];
-            (v.x[i], v.y[i], v.psi[i])
+            let [x, y, psi] = d.poses.pose[i][k];
+            (x, y, psi)
         };
         let (sx, sy, sp) = pose(0);
         if !(sx.is_finite() && sy.is_finite() && sp.is_finite()) {
@@ -883,7 +802,7 @@ where
             )))?;
         }
         chart.draw_series(std::iter::once(Text::new(
-            format!("{:.0} s", d.t[i]),
+            format!("{:.0} s", d.poses.t[i]),
             (sy + 0.9, sx + 0.4),
             (FAMILY, 13).into_font().color(&BLACK),
         )))?;
@@ -934,7 +853,7 @@ macro_rules! render {
 ///
 /// # Errors
 /// The font does not load, or a file cannot be drawn or written.
-pub fn write_plots(dir: &Path, d: &PlotData<'_>) -> Result<Vec<PlotFile>> {
+pub fn write_plots(dir: &Path, d: &PlotData) -> Result<Vec<PlotFile>> {
     ensure_font().map_err(|e| plot_error(dir, e))?;
     let mut out = Vec::new();
     let (map_size, er, nr) = map_layout(d);
@@ -948,7 +867,7 @@ pub fn write_plots(dir: &Path, d: &PlotData<'_>) -> Result<Vec<PlotFile>> {
         er.clone(),
         nr.clone()
     ));
-    let xr = x_range(&d.t);
+    let xr = x_range(d.t_span);
     let states = states_panels(d);
     let title = format!("vessel states (Fig. 12 style): {}", d.title);
     out.push(render!(
@@ -1046,7 +965,7 @@ mod tests {
         let t: Vec<f64> = (0..100_000).map(f64::from).collect();
         let mut v: Vec<f64> = t.iter().map(|x| (x * 0.001).sin()).collect();
         v[54_321] = 10.0;
-        let d = decimate(&t, &v);
+        let d = decimate_points(t.iter().copied().zip(v.iter().copied()).collect());
         assert!(d.len() <= MAX_POINTS);
         assert!(d.iter().any(|p| p.1 == 10.0));
         assert!(d.windows(2).all(|w| w[0].0 <= w[1].0));

@@ -1,12 +1,16 @@
-//! Streaming reader of one MCAP log into column vectors.
+//! Streaming reader of one MCAP log.
 //!
 //! The file is read front to back through a `BufReader` with the MCAP crate's sans-io
 //! [`LinearReader`] (mcap 0.26): memory scales with the largest chunk (1 MiB by default in
 //! the writer), never with the file. Each message of a topic of docs/logging.md is decoded
-//! into its `towing_log::topics` struct and appended to column vectors; the scene, `/tf` and
-//! prediction topics are skipped without decoding (they are most of a log's bytes and the
-//! report does not need them). Besides messages the reader keeps the `run` Metadata record
-//! and the `scenario.toml` attachment.
+//! into its `towing_log::topics` struct and handed to a [`Sink`], in file order: the
+//! column vectors of [`PlantData`] / [`ControllerData`] ([`read_log`], the controller log),
+//! or the streaming analysis of the plant log (`crate::stream`), which keeps nothing per
+//! step. The scene, `/tf` and prediction topics are skipped without decoding (they are most
+//! of a log's bytes and the report does not need them). Besides messages the reader keeps
+//! the `run` Metadata record and the `scenario.toml` attachment; [`peek_log`] reads only
+//! the records before the first message (metadata, attachment, channels) to tell a plant
+//! log from a controller log before either is read.
 //!
 //! A log that ends early (a crashed run, a file being written, a partial copy) stops the
 //! MCAP reader with an error at the first broken record; everything before it is kept and
@@ -396,7 +400,138 @@ pub struct DecodeErrors {
     pub first: String,
 }
 
-/// One log read into columns.
+/// One decoded message of a topic the analyzer uses.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Msg {
+    /// `/plant/ship` (0), `/plant/tug1` (1), `/plant/tug2` (2).
+    Vessel(usize, VesselState),
+    /// `/plant/towline1` (0), `/plant/towline2` (1).
+    Towline(usize, TowlineState),
+    /// `/plant/obstacles`.
+    Obstacles(Obstacles),
+    /// `/plant/inputs`.
+    Inputs(PlantInputs),
+    /// `/controller/reference`.
+    Reference(Reference),
+    /// `/controller/colregs`.
+    Colregs(Colregs),
+    /// `/controller/command`.
+    Command(Command),
+    /// `/controller/solver`.
+    Solver(Solver),
+}
+
+impl Msg {
+    /// True for the plant's topics.
+    #[must_use]
+    pub fn is_plant(&self) -> bool {
+        matches!(
+            self,
+            Msg::Vessel(..) | Msg::Towline(..) | Msg::Obstacles(_) | Msg::Inputs(_)
+        )
+    }
+}
+
+/// Receives the decoded messages of a log in file order, with their log time (ns).
+pub trait Sink {
+    /// One message.
+    ///
+    /// # Errors
+    /// The sink's own failure (writing a table); it stops the reading.
+    fn put(&mut self, t_ns: i64, msg: Msg) -> Result<()>;
+}
+
+impl PlantData {
+    /// Appends a plant message to the columns (controller messages are ignored).
+    pub fn push(&mut self, t_ns: i64, msg: Msg) {
+        match msg {
+            Msg::Vessel(0, m) => self.ship.push(t_ns, m),
+            Msg::Vessel(1, m) => self.tug1.push(t_ns, m),
+            Msg::Vessel(_, m) => self.tug2.push(t_ns, m),
+            Msg::Towline(k, m) => self.towlines[k.min(1)].push(t_ns, m),
+            Msg::Obstacles(m) => self.obstacles.push(t_ns, m),
+            Msg::Inputs(m) => self.inputs.push(t_ns, m),
+            _ => {}
+        }
+    }
+}
+
+impl Sink for PlantData {
+    fn put(&mut self, t_ns: i64, msg: Msg) -> Result<()> {
+        self.push(t_ns, msg);
+        Ok(())
+    }
+}
+
+impl ControllerData {
+    /// Appends a controller message to the columns (plant messages are ignored).
+    pub fn push(&mut self, t_ns: i64, msg: Msg) {
+        match msg {
+            Msg::Reference(m) => self.reference.push(t_ns, m),
+            Msg::Colregs(m) => self.colregs.push(t_ns, m),
+            Msg::Command(m) => self.command.push(t_ns, m),
+            Msg::Solver(m) => self.solver.push(t_ns, m),
+            _ => {}
+        }
+    }
+}
+
+impl Sink for ControllerData {
+    fn put(&mut self, t_ns: i64, msg: Msg) -> Result<()> {
+        self.push(t_ns, msg);
+        Ok(())
+    }
+}
+
+/// Both units' columns (everything [`read_log`] keeps).
+struct Everything<'a> {
+    plant: &'a mut PlantData,
+    controller: &'a mut ControllerData,
+}
+
+impl Sink for Everything<'_> {
+    fn put(&mut self, t_ns: i64, msg: Msg) -> Result<()> {
+        if msg.is_plant() {
+            self.plant.push(t_ns, msg);
+        } else {
+            self.controller.push(t_ns, msg);
+        }
+        Ok(())
+    }
+}
+
+/// Messages decoded per kind (whether or not a sink kept them).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Decoded {
+    /// `/plant/ship` messages.
+    pub ship: u64,
+    /// All plant messages.
+    pub plant: u64,
+    /// `/controller/solver`, `/controller/command` and `/controller/reference` messages.
+    pub controller_core: u64,
+    /// All controller messages.
+    pub controller: u64,
+    /// Messages whose log time is earlier than the message before them.
+    pub out_of_order: u64,
+}
+
+/// What the records before a log's first message say (see [`peek_log`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Peek {
+    /// The file.
+    pub path: PathBuf,
+    /// Size of the file, bytes.
+    pub bytes: u64,
+    /// The unit, from the `run` metadata and the topics of the channels seen; `None` when
+    /// neither tells.
+    pub unit: Option<Unit>,
+    /// The `run` Metadata record (empty if not seen).
+    pub metadata: BTreeMap<String, String>,
+    /// The `scenario.toml` attachment, if seen before the first message.
+    pub scenario_text: Option<String>,
+}
+
+/// One log read: what was found, and the columns when read with [`read_log`].
 #[derive(Debug, Clone)]
 pub struct LogFile {
     /// The file.
@@ -417,42 +552,30 @@ pub struct LogFile {
     pub schema_mismatches: Vec<String>,
     /// Size of the file, bytes.
     pub bytes: u64,
-    /// Plant topics.
+    /// Plant topics (filled by [`read_log`] only).
     pub plant: PlantData,
-    /// Controller topics.
+    /// Controller topics (filled by [`read_log`] only).
     pub controller: ControllerData,
     /// `/plant/log` and `/controller/log`.
     pub logs: Vec<LogLine>,
+    /// Messages decoded, per kind.
+    pub decoded: Decoded,
 }
 
 impl LogFile {
     /// True when the file holds the plant's vessel states.
     pub fn has_plant(&self) -> bool {
-        !self.plant.ship.t_ns.is_empty()
+        self.decoded.ship > 0
     }
 
-    /// True when the file holds any controller message.
+    /// True when the file holds any controller message (solver, command or reference).
     pub fn has_controller(&self) -> bool {
-        !(self.controller.solver.t_ns.is_empty()
-            && self.controller.command.t_ns.is_empty()
-            && self.controller.reference.t_ns.is_empty())
+        self.decoded.controller_core > 0
     }
 
-    /// Total messages decoded into columns.
-    fn decoded(&self) -> usize {
-        let p = &self.plant;
-        let c = &self.controller;
-        p.ship.t_ns.len()
-            + p.tug1.t_ns.len()
-            + p.tug2.t_ns.len()
-            + p.towlines[0].t_ns.len()
-            + p.towlines[1].t_ns.len()
-            + p.obstacles.t_ns.len()
-            + p.inputs.t_ns.len()
-            + c.reference.t_ns.len()
-            + c.colregs.t_ns.len()
-            + c.command.t_ns.len()
-            + c.solver.t_ns.len()
+    /// Messages decoded into [`Msg`]s (the unit logs not counted).
+    fn decoded_total(&self) -> u64 {
+        self.decoded.plant + self.decoded.controller
     }
 }
 
@@ -520,14 +643,69 @@ struct ChannelInfo {
     json: bool,
 }
 
-/// Reads one log. `progress` is advanced by the bytes read (pass
-/// `ProgressBar::hidden()` for none).
+/// Reads one log into columns (both units' topics). `progress` is advanced by the bytes
+/// read (pass `ProgressBar::hidden()` for none).
 ///
 /// # Errors
 /// The file is missing or unreadable, not MCAP, has none of the expected topics, or not one
 /// message could be used. A log that ends early is not an error (see
 /// [`LogFile::truncated`]).
 pub fn read_log(path: &Path, progress: &indicatif::ProgressBar) -> Result<LogFile> {
+    let mut plant = PlantData::default();
+    let mut controller = ControllerData::default();
+    let mut log = read_into(
+        path,
+        progress,
+        &mut Everything {
+            plant: &mut plant,
+            controller: &mut controller,
+        },
+    )?;
+    log.plant = plant;
+    log.controller = controller;
+    Ok(log)
+}
+
+/// Reads one log, handing every decoded message to `sink` in file order; the returned
+/// [`LogFile`] has empty columns.
+///
+/// # Errors
+/// As [`read_log`], and the sink's errors.
+pub fn read_into(
+    path: &Path,
+    progress: &indicatif::ProgressBar,
+    sink: &mut dyn Sink,
+) -> Result<LogFile> {
+    let (log, channels) = scan(path, progress, Some(sink))?;
+    finish(log, &channels)
+}
+
+/// Reads the records of a log up to its first message: the `run` metadata, the scenario
+/// attachment and the channels registered before it (`towing_log::LogWriter` registers
+/// every channel and writes both records when the file is created), enough to tell the
+/// unit. Reads at most one chunk.
+///
+/// # Errors
+/// The file is missing or unreadable, empty, or not MCAP (the errors [`read_log`] would
+/// give first).
+pub fn peek_log(path: &Path) -> Result<Peek> {
+    let (log, channels) = scan(path, &indicatif::ProgressBar::hidden(), None)?;
+    let (plant, controller) = unit_topics(&channels);
+    Ok(Peek {
+        path: log.path,
+        bytes: log.bytes,
+        unit: decide_unit(&log.metadata, plant, controller),
+        metadata: log.metadata,
+        scenario_text: log.scenario_text,
+    })
+}
+
+/// The reading loop: every record with `sink`, or (`None`) up to the first message.
+fn scan(
+    path: &Path,
+    progress: &indicatif::ProgressBar,
+    mut sink: Option<&mut dyn Sink>,
+) -> Result<(LogFile, BTreeMap<u16, ChannelInfo>)> {
     let io_err = |source| AnalyzerError::Io {
         path: path.to_owned(),
         source,
@@ -562,12 +740,14 @@ pub fn read_log(path: &Path, progress: &indicatif::ProgressBar) -> Result<LogFil
         plant: PlantData::default(),
         controller: ControllerData::default(),
         logs: Vec::new(),
+        decoded: Decoded::default(),
     };
     let mut channels: BTreeMap<u16, ChannelInfo> = BTreeMap::new();
     let mut schema_names: BTreeMap<u16, String> = BTreeMap::new();
     let mut reader = LinearReader::new();
     let mut past_data_end = false;
     let mut records = 0u64;
+    let mut last_t_ns = i64::MIN;
 
     while let Some(event) = reader.next_event() {
         let event = match event {
@@ -632,6 +812,10 @@ pub fn read_log(path: &Path, progress: &indicatif::ProgressBar) -> Result<LogFil
                         );
                     }
                     Record::Message { header, data } => {
+                        let Some(sink) = sink.as_deref_mut() else {
+                            // Peeking: the records before the first message are read.
+                            break;
+                        };
                         let Some(channel) = channels.get(&header.channel_id) else {
                             continue;
                         };
@@ -648,7 +832,13 @@ pub fn read_log(path: &Path, progress: &indicatif::ProgressBar) -> Result<LogFil
                             continue;
                         }
                         let t_ns = i64::try_from(header.log_time).unwrap_or(i64::MAX);
-                        decode_into(&mut log, channel, t_ns, &data);
+                        if let Some(msg) = decode_msg(&mut log, channel, t_ns, &data) {
+                            if t_ns < last_t_ns {
+                                log.decoded.out_of_order += 1;
+                            }
+                            last_t_ns = last_t_ns.max(t_ns);
+                            sink.put(t_ns, msg)?;
+                        }
                     }
                     Record::Metadata(m) if m.name == topics::METADATA_RUN => {
                         log.metadata = m.metadata;
@@ -664,7 +854,7 @@ pub fn read_log(path: &Path, progress: &indicatif::ProgressBar) -> Result<LogFil
         }
     }
     progress.set_position(bytes);
-    finish(log, &channels)
+    Ok((log, channels))
 }
 
 /// Turns the reader's error into "not MCAP" (nothing read yet) or a truncation mark.
@@ -712,97 +902,86 @@ fn decode<T: DeserializeOwned>(log: &mut LogFile, topic: &str, data: &[u8]) -> O
     }
 }
 
-fn decode_into(log: &mut LogFile, channel: &ChannelInfo, t_ns: i64, data: &[u8]) {
+/// Decodes one message of a used topic (unit logs go to [`LogFile::logs`]) and counts it.
+fn decode_msg(log: &mut LogFile, channel: &ChannelInfo, t_ns: i64, data: &[u8]) -> Option<Msg> {
     let topic = channel.topic.as_str();
-    match channel.kind {
-        Topic::Ship => {
-            if let Some(m) = decode::<VesselState>(log, topic, data) {
-                log.plant.ship.push(t_ns, m);
-            }
-        }
-        Topic::Tug1 => {
-            if let Some(m) = decode::<VesselState>(log, topic, data) {
-                log.plant.tug1.push(t_ns, m);
-            }
-        }
-        Topic::Tug2 => {
-            if let Some(m) = decode::<VesselState>(log, topic, data) {
-                log.plant.tug2.push(t_ns, m);
-            }
-        }
-        Topic::Towline1 => {
-            if let Some(m) = decode::<TowlineState>(log, topic, data) {
-                log.plant.towlines[0].push(t_ns, m);
-            }
-        }
-        Topic::Towline2 => {
-            if let Some(m) = decode::<TowlineState>(log, topic, data) {
-                log.plant.towlines[1].push(t_ns, m);
-            }
-        }
-        Topic::Obstacles => {
-            if let Some(m) = decode::<Obstacles>(log, topic, data) {
-                log.plant.obstacles.push(t_ns, m);
-            }
-        }
-        Topic::Inputs => {
-            if let Some(m) = decode::<PlantInputs>(log, topic, data) {
-                log.plant.inputs.push(t_ns, m);
-            }
-        }
-        Topic::Reference => {
-            if let Some(m) = decode::<Reference>(log, topic, data) {
-                log.controller.reference.push(t_ns, m);
-            }
-        }
-        Topic::Colregs => {
-            if let Some(m) = decode::<Colregs>(log, topic, data) {
-                log.controller.colregs.push(t_ns, m);
-            }
-        }
-        Topic::Command => {
-            if let Some(m) = decode::<Command>(log, topic, data) {
-                log.controller.command.push(t_ns, m);
-            }
-        }
-        Topic::Solver => {
-            if let Some(m) = decode::<Solver>(log, topic, data) {
-                log.controller.solver.push(t_ns, m);
-            }
-        }
+    let msg = match channel.kind {
+        Topic::Ship => Msg::Vessel(0, decode(log, topic, data)?),
+        Topic::Tug1 => Msg::Vessel(1, decode(log, topic, data)?),
+        Topic::Tug2 => Msg::Vessel(2, decode(log, topic, data)?),
+        Topic::Towline1 => Msg::Towline(0, decode(log, topic, data)?),
+        Topic::Towline2 => Msg::Towline(1, decode(log, topic, data)?),
+        Topic::Obstacles => Msg::Obstacles(decode(log, topic, data)?),
+        Topic::Inputs => Msg::Inputs(decode(log, topic, data)?),
+        Topic::Reference => Msg::Reference(decode(log, topic, data)?),
+        Topic::Colregs => Msg::Colregs(decode(log, topic, data)?),
+        Topic::Command => Msg::Command(decode(log, topic, data)?),
+        Topic::Solver => Msg::Solver(decode(log, topic, data)?),
         Topic::PlantLog | Topic::ControllerLog => {
-            if let Some(m) = decode::<Log>(log, topic, data) {
-                log.logs.push(LogLine {
-                    t_ns,
-                    level: m.level,
-                    name: m.name,
-                    message: m.message,
-                });
-            }
+            let m: Log = decode(log, topic, data)?;
+            log.logs.push(LogLine {
+                t_ns,
+                level: m.level,
+                name: m.name,
+                message: m.message,
+            });
+            return None;
         }
-        Topic::Skip | Topic::Foreign => {}
+        Topic::Skip | Topic::Foreign => return None,
+    };
+    let d = &mut log.decoded;
+    match &msg {
+        Msg::Vessel(0, _) => {
+            d.ship += 1;
+            d.plant += 1;
+        }
+        Msg::Reference(_) | Msg::Command(_) | Msg::Solver(_) => {
+            d.controller_core += 1;
+            d.controller += 1;
+        }
+        Msg::Colregs(_) => d.controller += 1,
+        _ => d.plant += 1,
+    }
+    Some(msg)
+}
+
+/// Whether the channels include plant topics and controller topics of the contract.
+fn unit_topics(channels: &BTreeMap<u16, ChannelInfo>) -> (bool, bool) {
+    let plant = channels
+        .values()
+        .any(|c| c.topic.starts_with("/plant/") && c.kind != Topic::Foreign);
+    let controller = channels
+        .values()
+        .any(|c| c.topic.starts_with("/controller/") && c.kind != Topic::Foreign);
+    (plant, controller)
+}
+
+/// The unit from both prefixes, else the metadata, else the topics.
+fn decide_unit(
+    metadata: &BTreeMap<String, String>,
+    plant_topics: bool,
+    controller_topics: bool,
+) -> Option<Unit> {
+    let by_metadata = match metadata.get(metadata_keys::UNIT).map(String::as_str) {
+        Some("TowingPlant") => Some(Unit::Plant),
+        Some("TowingController") => Some(Unit::Controller),
+        _ => None,
+    };
+    match (by_metadata, plant_topics, controller_topics) {
+        (_, true, true) => Some(Unit::Both),
+        (Some(unit), _, _) => Some(unit),
+        (None, true, false) => Some(Unit::Plant),
+        (None, false, true) => Some(Unit::Controller),
+        (None, false, false) => None,
     }
 }
 
 /// Decides the unit and refuses files with nothing useful.
 fn finish(mut log: LogFile, channels: &BTreeMap<u16, ChannelInfo>) -> Result<LogFile> {
-    let plant_topics = channels
-        .values()
-        .any(|c| c.topic.starts_with("/plant/") && c.kind != Topic::Foreign);
-    let controller_topics = channels
-        .values()
-        .any(|c| c.topic.starts_with("/controller/") && c.kind != Topic::Foreign);
-    let by_metadata = match log.metadata.get(metadata_keys::UNIT).map(String::as_str) {
-        Some("TowingPlant") => Some(Unit::Plant),
-        Some("TowingController") => Some(Unit::Controller),
-        _ => None,
-    };
-    log.unit = match (by_metadata, plant_topics, controller_topics) {
-        (_, true, true) => Unit::Both,
-        (Some(unit), _, _) => unit,
-        (None, true, false) => Unit::Plant,
-        (None, false, true) => Unit::Controller,
-        (None, false, false) => {
+    let (plant_topics, controller_topics) = unit_topics(channels);
+    log.unit = match decide_unit(&log.metadata, plant_topics, controller_topics) {
+        Some(unit) => unit,
+        None => {
             let mut topics: Vec<&str> = channels.values().map(|c| c.topic.as_str()).collect();
             topics.sort_unstable();
             topics.dedup();
@@ -823,7 +1002,7 @@ fn finish(mut log: LogFile, channels: &BTreeMap<u16, ChannelInfo>) -> Result<Log
             });
         }
     };
-    if log.decoded() == 0 {
+    if log.decoded_total() == 0 {
         let reason = if let Some((topic, e)) = log.decode_errors.iter().next() {
             format!(
                 "{} messages of {topic} do not match docs/logging.md: {}",

@@ -6,15 +6,16 @@ use std::path::{Path, PathBuf};
 
 use polars::prelude::*;
 
-use crate::analysis::{analyze, Metrics, VESSELS};
+use crate::analysis::{analyze_run, Metrics, VESSELS};
 use crate::colregs::EncounterReport;
 use crate::compare::{num, table6, table7, RunSummary};
 use crate::doc::{to_html, to_markdown, Block};
 use crate::error::{AnalyzerError, Result};
-use crate::frames::{self, Frames};
+use crate::frames::ControllerFrames;
 use crate::plots::{write_plots, PlotFile};
 use crate::progress;
 use crate::run::load_run;
+use crate::stream::{StreamOptions, TableOut};
 
 /// What `report` wrote.
 #[derive(Debug, Clone)]
@@ -30,30 +31,33 @@ pub struct ReportOutcome {
 /// # Errors
 /// See [`crate::error::AnalyzerError`]: unusable inputs name the file and the problem.
 pub fn report(out: &Path, logs: &[PathBuf], quiet: bool) -> Result<ReportOutcome> {
+    report_with(out, logs, quiet, &StreamOptions::default())
+}
+
+/// [`report`] with the streaming analysis' sizes `opts`.
+///
+/// # Errors
+/// As [`report`].
+pub fn report_with(
+    out: &Path,
+    logs: &[PathBuf],
+    quiet: bool,
+    opts: &StreamOptions,
+) -> Result<ReportOutcome> {
     let multi = progress::multi(quiet);
     let run = load_run(logs, &multi)?;
-    let stage = progress::stage(&multi, "tables");
-    let crate::run::Run {
-        files,
-        plant,
-        controller,
-        logs: unit_logs,
-        config,
-        notes,
-    } = run;
-    let frames = frames::build(plant, controller, &config.route)?;
-    let levels: Vec<i32> = unit_logs.iter().map(|l| l.level).collect();
-    let analysis = analyze(&frames, &config, files, notes, &levels)?;
-
     std::fs::create_dir_all(out).map_err(|e| AnalyzerError::write(out, e))?;
+    let analysis = analyze_run(run, Some(out), &multi, opts)?;
+
+    let stage = progress::stage(&multi, "tables");
     let mut written = Vec::new();
     let metrics_path = out.join("metrics.json");
     let text = serde_json::to_string_pretty(&analysis.metrics)
         .map_err(|e| AnalyzerError::write(&metrics_path, e))?;
     std::fs::write(&metrics_path, text).map_err(|e| AnalyzerError::write(&metrics_path, e))?;
     written.push(metrics_path);
-
-    written.extend(write_tables(out, &frames, &analysis.metrics)?);
+    written.extend(analysis.tables.iter().cloned());
+    written.extend(write_tables(out, &analysis.controller, &analysis.metrics)?);
     stage.set_message("plots");
     let plots = write_plots(out, &analysis.plot)?;
     for p in &plots {
@@ -203,60 +207,40 @@ fn distance_frame(m: &Metrics) -> Result<DataFrame> {
     .map_err(|e| AnalyzerError::frame("min_distances", e))
 }
 
-/// Rows of the plant-time table joined and written per batch.
-const TIMESERIES_BATCH: usize = 100_000;
+/// Rows of the controller's tables built and written per chunk.
+const CHUNK_ROWS: usize = 100_000;
 
-/// Writes [`Frames::timeseries`] batch by batch (CSV and Parquet), so its joined copy is
-/// never whole in memory.
-fn write_timeseries(out: &Path, frames: &Frames, rows: usize) -> Result<Vec<PathBuf>> {
-    let csv = out.join("timeseries.csv");
-    let pq = out.join("timeseries.parquet");
-    let rows = rows.max(1);
-    let first = frames.timeseries(0, rows.min(frames.vessels.height()))?;
-    let schema = first.schema().as_ref().clone();
-    let f = File::create(&csv).map_err(|e| AnalyzerError::write(&csv, e))?;
-    let mut csv_w = CsvWriter::new(std::io::BufWriter::new(f))
-        .batched(&schema)
-        .map_err(|e| AnalyzerError::write(&csv, e))?;
-    let f = File::create(&pq).map_err(|e| AnalyzerError::write(&pq, e))?;
-    let mut pq_w = ParquetWriter::new(f)
-        .batched(&schema)
-        .map_err(|e| AnalyzerError::write(&pq, e))?;
+/// Writes a table of `height` rows chunk by chunk (`rows(offset, len)`), CSV and Parquet.
+fn write_chunks(
+    out: &Path,
+    stem: &str,
+    height: usize,
+    rows: impl Fn(usize, usize) -> Result<DataFrame>,
+) -> Result<Vec<PathBuf>> {
+    let mut table = TableOut::new(out, stem);
     let mut offset = 0;
-    let mut batch = first;
     loop {
-        batch.rechunk_mut();
-        csv_w
-            .write_batch(&batch)
-            .map_err(|e| AnalyzerError::write(&csv, e))?;
-        pq_w.write_batch(&batch)
-            .map_err(|e| AnalyzerError::write(&pq, e))?;
-        offset += batch.height();
-        if batch.height() == 0 || offset >= frames.vessels.height() {
+        table.write(&mut rows(offset, CHUNK_ROWS)?)?;
+        offset += CHUNK_ROWS;
+        if offset >= height {
             break;
         }
-        batch = frames.timeseries(offset, rows)?;
     }
-    csv_w.finish().map_err(|e| AnalyzerError::write(&csv, e))?;
-    pq_w.finish().map_err(|e| AnalyzerError::write(&pq, e))?;
-    Ok(vec![csv, pq])
+    table.finish()
 }
 
-/// Writes the tables as CSV and Parquet: `timeseries`, `controller`, `obstacles`,
-/// `colregs`, `encounters`, `min_distances`.
-fn write_tables(out: &Path, frames: &Frames, m: &Metrics) -> Result<Vec<PathBuf>> {
-    let mut w = write_timeseries(out, frames, TIMESERIES_BATCH)?;
-    w.extend(write_frame(
+/// Writes the tables not written while the plant log streamed, as CSV and Parquet:
+/// `controller`, `colregs` (in chunks), `encounters`, `min_distances`.
+fn write_tables(out: &Path, ctrl: &ControllerFrames, m: &Metrics) -> Result<Vec<PathBuf>> {
+    let mut w = write_chunks(out, "controller", ctrl.controller_height(), |o, n| {
+        ctrl.controller_rows(o, n)
+    })?;
+    w.extend(write_chunks(
         out,
-        "controller",
-        &mut frames.controller.clone(),
+        "colregs",
+        ctrl.colregs_height(),
+        |o, n| ctrl.colregs_rows(o, n),
     )?);
-    w.extend(write_frame(
-        out,
-        "obstacles",
-        &mut frames.obstacles.clone(),
-    )?);
-    w.extend(write_frame(out, "colregs", &mut frames.colregs.clone())?);
     w.extend(write_frame(
         out,
         "encounters",
@@ -649,30 +633,63 @@ mod tests {
     use super::*;
     use crate::synth::SynthRun;
 
+    fn read_csv(path: &Path) -> String {
+        std::fs::read_to_string(path).expect("csv")
+    }
+
+    /// The regression this guards: the plant log is analysed in batches with rows carried
+    /// over for the as-of joins; any batch size must give the tables and metrics of one
+    /// batch (the whole log at once, as the analyzer did before streaming).
     #[test]
-    fn timeseries_in_batches_equals_one_join() {
+    fn batches_of_any_size_give_the_tables_and_metrics_of_one_batch() {
         let dir = tempfile::tempdir().expect("tempdir");
         let mut run = SynthRun::paper(2345);
         run.scene = false;
+        run.speed = 0.2;
+        run.obstacles[4].active_from = 405.0 * 0.3;
+        run.obstacles[5].active_from = 590.0 * 0.3;
+        run.tension_spike_at_sample = Some(40);
         let (plant, controller) = (dir.path().join("p.mcap"), dir.path().join("c.mcap"));
         run.write(&plant, &controller).expect("logs");
-        let r = load_run(&[plant, controller], &progress::multi(true)).expect("run");
-        let frames = frames::build(r.plant, r.controller, &r.config.route).expect("frames");
-        let whole = frames.timeseries(0, usize::MAX).expect("whole");
-        assert_eq!(whole.height(), 2346);
-        let written = write_timeseries(dir.path(), &frames, 700).expect("written");
-        let csv = std::fs::read_to_string(&written[0]).expect("csv");
-        assert_eq!(csv.lines().count(), 2346 + 1, "one header, every row once");
-        let f = File::open(&written[1]).expect("parquet");
-        let back = ParquetReader::new(f).finish().expect("read parquet");
-        assert_eq!(back.height(), 2346);
-        assert_eq!(back.width(), whole.width());
-        let a = crate::frames::f64s(&back, "cmd_tension1").expect("col");
-        let b = crate::frames::f64s(&whole, "cmd_tension1").expect("col");
-        assert_eq!(a.len(), b.len());
-        assert!(a
-            .iter()
-            .zip(&b)
-            .all(|(x, y)| x == y || (x.is_nan() && y.is_nan())));
+        let logs = [plant, controller];
+        let whole_dir = dir.path().join("whole");
+        let whole = StreamOptions {
+            batch_steps: usize::MAX,
+            ..StreamOptions::default()
+        };
+        let w = report_with(&whole_dir, &logs, true, &whole).expect("one batch");
+        for batch_steps in [7, 97, 700] {
+            let out = dir.path().join(format!("b{batch_steps}"));
+            let opts = StreamOptions {
+                batch_steps,
+                ..StreamOptions::default()
+            };
+            let b = report_with(&out, &logs, true, &opts).expect("batches");
+            assert_eq!(w.metrics, b.metrics, "batch {batch_steps}");
+            for stem in ["timeseries", "obstacles", "controller"] {
+                let a = read_csv(&whole_dir.join(format!("{stem}.csv")));
+                let c = read_csv(&out.join(format!("{stem}.csv")));
+                assert_eq!(a, c, "{stem}.csv, batch {batch_steps}");
+                let back = ParquetReader::new(
+                    File::open(out.join(format!("{stem}.parquet"))).expect("parquet"),
+                )
+                .finish()
+                .expect("read parquet");
+                assert_eq!(back.height() + 1, c.lines().count(), "{stem}.parquet");
+            }
+        }
+        let ts = read_csv(&whole_dir.join("timeseries.csv"));
+        assert_eq!(ts.lines().count(), 2346 + 1, "one header, every step once");
+        let header = ts.lines().next().expect("header");
+        for c in [
+            "t_ns",
+            "ship_x",
+            "line2_tension",
+            "in_tug2_N",
+            "cmd_tension1",
+            "wp_psi",
+        ] {
+            assert!(header.split(',').any(|h| h == c), "{c} in {header}");
+        }
     }
 }

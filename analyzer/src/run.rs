@@ -1,5 +1,11 @@
 //! One run: the plant log and the controller log put together, with the scenario and the
 //! parameters the metrics need.
+//!
+//! [`load_run`] tells the logs apart from the records before their first message
+//! ([`peek_log`]: the `run` metadata, the scenario attachment, the channels), reads every
+//! log but the plant's whole (the controller log: about a tenth of the plant's messages;
+//! only its topics are kept), and takes the scenario and the controller's parameters. The
+//! plant log itself is streamed later, once, by [`crate::analysis::analyze_run`].
 
 use std::path::{Path, PathBuf};
 
@@ -8,7 +14,7 @@ use towing_log::topics::metadata_keys;
 use towing_model::Scenario;
 
 use crate::error::{AnalyzerError, Result};
-use crate::read::{read_log, ControllerData, LogFile, LogLine, PlantData};
+use crate::read::{peek_log, read_into, ControllerData, LogFile, LogLine, Peek, Unit};
 
 /// What was read from one file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -95,126 +101,234 @@ pub struct RunConfig {
     pub scheme: Option<i32>,
 }
 
-/// A run ready for analysis.
+/// A run ready for analysis: the controller's data and the settings; the plant log is
+/// streamed by the analysis.
 #[derive(Debug, Clone)]
 pub struct Run {
-    /// The files read.
+    /// The files read, in the order given (the plant log's entry is completed by the
+    /// analysis), then the files left out.
     pub files: Vec<FileSummary>,
-    /// Plant topics.
-    pub plant: PlantData,
+    /// The plant log.
+    pub plant_path: PathBuf,
+    /// Index of the plant log in `files`.
+    pub plant_file: usize,
     /// Controller topics (empty when no controller log was given).
     pub controller: ControllerData,
-    /// Warnings and errors logged by the units.
+    /// Warnings and errors logged by the units (the plant log's are added by the
+    /// analysis).
     pub logs: Vec<LogLine>,
     /// Sizes and settings.
     pub config: RunConfig,
     /// Notes for the report (missing controller log, default scenario, ...).
     pub notes: Vec<String>,
+    /// The logs given.
+    paths: Vec<PathBuf>,
+    /// The plant log was read whole too (it holds controller topics, or was re-read).
+    plant_read_whole: bool,
+    /// The scenario came from the plant log.
+    plant_scenario: bool,
+    /// Index in `paths` of the controller log, if any.
+    controller_path: Option<usize>,
 }
 
 impl Run {
-    /// True when any file ended early.
+    /// True when any file ended early (so far: the plant log's end is known after the
+    /// analysis).
     pub fn truncated(&self) -> bool {
         self.files.iter().any(|f| f.truncated.is_some())
     }
+
+    /// The files, comma separated (for messages).
+    #[must_use]
+    pub fn file_list(&self) -> String {
+        self.paths
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// Whether the streamed plant log `log` showed what its first records did not: controller
+    /// messages or the scenario attachment after its first message. Then the run must be
+    /// loaded again with the plant log read whole ([`Run::reload`]).
+    ///
+    /// # Errors
+    /// The plant log holds controller messages and another log is the controller's.
+    pub fn needs_whole_read(&self, log: &LogFile) -> Result<bool> {
+        if self.plant_read_whole {
+            return Ok(false);
+        }
+        if log.has_controller() {
+            if let Some(k) = self.controller_path {
+                return Err(AnalyzerError::DuplicateUnit {
+                    unit: "controller",
+                    first: self.paths[k].clone(),
+                    second: self.plant_path.clone(),
+                });
+            }
+            return Ok(true);
+        }
+        Ok(log.scenario_text.is_some() && !self.plant_scenario)
+    }
+
+    /// The run loaded again with the plant log read whole first.
+    ///
+    /// # Errors
+    /// As [`load_run`].
+    pub fn reload(&self, progress: &indicatif::MultiProgress) -> Result<Run> {
+        load(&self.paths, progress, Some(&self.plant_path))
+    }
+
+    /// The files (the plant log's summary from its streamed read), the notes and the units'
+    /// log levels, once the plant log `log` has been streamed.
+    #[must_use]
+    pub fn complete(self, log: LogFile) -> (Vec<FileSummary>, Vec<String>, Vec<i32>) {
+        let mut files = self.files;
+        files[self.plant_file] = summarize(&log);
+        let mut logs = self.logs;
+        logs.extend(log.logs);
+        logs.sort_by_key(|l| l.t_ns);
+        let mut notes = self.notes;
+        if log.decoded.out_of_order > 0 {
+            notes.push(format!(
+                "{}: {} messages are older than the message before them; the log is \
+                 streamed in batches, so an as-of join across a batch boundary may differ \
+                 from a whole-log sort",
+                log.path.display(),
+                log.decoded.out_of_order
+            ));
+        }
+        (files, notes, logs.iter().map(|l| l.level).collect())
+    }
 }
 
-/// Reads the logs of one run (any order) and puts them together.
+/// Reads the logs of one run (any order) and puts them together; the plant log is only
+/// peeked at (it is streamed by the analysis).
 ///
 /// # Errors
-/// Any file that cannot be used (see [`read_log`]), two logs of the same unit, no plant
-/// log, or an attached scenario that does not parse.
+/// Any file that cannot be used (see [`crate::read::read_log`]), two logs of the same
+/// unit, no plant log, or an attached scenario that does not parse.
 pub fn load_run(paths: &[PathBuf], progress: &indicatif::MultiProgress) -> Result<Run> {
+    load(paths, progress, None)
+}
+
+/// [`load_run`]; `plant_whole`: the plant log, to be read whole too.
+fn load(
+    paths: &[PathBuf],
+    progress: &indicatif::MultiProgress,
+    plant_whole: Option<&Path>,
+) -> Result<Run> {
     if paths.is_empty() {
         return Err(AnalyzerError::Usage(
             "no log given: analyzer report --out DIR PLANT.mcap CONTROLLER.mcap".to_owned(),
         ));
     }
-    let mut logs = Vec::with_capacity(paths.len());
+    let peeks = paths
+        .iter()
+        .map(|p| peek_log(p))
+        .collect::<Result<Vec<Peek>>>()?;
+    // The plant log: peeked as one (or as both units).
+    let mut plant: Option<usize> = None;
+    for (k, peek) in peeks.iter().enumerate() {
+        let is_plant = matches!(peek.unit, Some(Unit::Plant | Unit::Both))
+            || plant_whole == Some(peek.path.as_path());
+        if is_plant {
+            if let Some(first) = plant {
+                return Err(AnalyzerError::DuplicateUnit {
+                    unit: "plant",
+                    first: paths[first].clone(),
+                    second: paths[k].clone(),
+                });
+            }
+            plant = Some(k);
+        }
+    }
+    // Every other log whole, keeping the controller's topics; a merged log too.
+    let mut logs: Vec<(usize, LogFile)> = Vec::new();
     let mut empty = Vec::new();
-    for path in paths {
+    for (k, path) in paths.iter().enumerate() {
+        let whole = plant != Some(k)
+            || peeks[k].unit == Some(Unit::Both)
+            || plant_whole == Some(path.as_path());
+        if !whole {
+            continue;
+        }
         let bar = progress.add(crate::progress::bytes_bar(path));
-        let log = read_log(path, &bar);
+        let mut controller = ControllerData::default();
+        let log = read_into(path, &bar, &mut controller);
         bar.finish_and_clear();
         match log {
-            Ok(log) => logs.push(log),
+            Ok(mut log) => {
+                log.controller = controller;
+                logs.push((k, log));
+            }
             // A log cut before its first message: the others may still make a report.
-            Err(AnalyzerError::TruncatedEmpty { path, reason }) => empty.push((path, reason)),
+            Err(AnalyzerError::TruncatedEmpty { path, reason }) if plant != Some(k) => {
+                empty.push((path, reason));
+            }
             Err(e) => return Err(e),
         }
     }
-    if logs.is_empty() || !logs.iter().any(LogFile::has_plant) {
+    // A log read whole may hold the plant's states where its first records did not say.
+    for (k, log) in &logs {
+        if log.has_plant() && plant != Some(*k) {
+            if let Some(first) = plant {
+                return Err(AnalyzerError::DuplicateUnit {
+                    unit: "plant",
+                    first: paths[first].clone(),
+                    second: paths[*k].clone(),
+                });
+            }
+            plant = Some(*k);
+        }
+    }
+    let Some(plant) = plant else {
         if let Some((path, reason)) = empty.first() {
             return Err(AnalyzerError::TruncatedEmpty {
                 path: path.clone(),
                 reason: reason.clone(),
             });
         }
-    }
-    let mut run = assemble(logs)?;
-    for (path, reason) in empty {
-        run.notes.push(format!(
-            "{} is truncated before any usable message and was left out",
-            path.display()
-        ));
-        run.files.push(FileSummary {
-            path,
-            unit: "unknown (truncated)",
-            bytes: 0,
-            messages: std::collections::BTreeMap::new(),
-            decode_errors: std::collections::BTreeMap::new(),
-            schema_mismatches: Vec::new(),
-            truncated: Some(reason),
-            metadata: std::collections::BTreeMap::new(),
-        });
-    }
-    Ok(run)
-}
-
-/// Puts logs already read together (see [`load_run`]).
-///
-/// # Errors
-/// Two logs of the same unit, no plant log, or an attached scenario that does not parse.
-pub fn assemble(logs: Vec<LogFile>) -> Result<Run> {
-    let mut plant_file: Option<usize> = None;
-    let mut controller_file: Option<usize> = None;
-    for (k, log) in logs.iter().enumerate() {
-        if log.has_plant() {
-            if let Some(first) = plant_file {
-                return Err(AnalyzerError::DuplicateUnit {
-                    unit: "plant",
-                    first: logs[first].path.clone(),
-                    second: log.path.clone(),
-                });
-            }
-            plant_file = Some(k);
-        }
+        let files = logs
+            .iter()
+            .map(|(_, l)| l.path.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ");
+        return Err(AnalyzerError::NoPlantLog { files });
+    };
+    let mut controller_path: Option<usize> = None;
+    for (k, log) in &logs {
         if log.has_controller() {
-            if let Some(first) = controller_file {
+            if let Some(first) = controller_path {
                 return Err(AnalyzerError::DuplicateUnit {
                     unit: "controller",
-                    first: logs[first].path.clone(),
-                    second: log.path.clone(),
+                    first: paths[first].clone(),
+                    second: paths[*k].clone(),
                 });
             }
-            controller_file = Some(k);
+            controller_path = Some(*k);
         }
     }
-    let files_list = logs
-        .iter()
-        .map(|l| l.path.display().to_string())
-        .collect::<Vec<_>>()
-        .join(", ");
-    let Some(plant_idx) = plant_file else {
-        return Err(AnalyzerError::NoPlantLog { files: files_list });
-    };
+    let plant_read_whole = logs.iter().any(|(k, _)| *k == plant);
 
+    // The scenario: the plant log's (as peeked, or read whole), else the controller's.
     let mut notes = Vec::new();
-    let (scenario, scenario_source) = scenario_of(&logs, plant_idx, controller_file, &mut notes)?;
-    let params = controller_file
-        .and_then(|k| logs[k].metadata.get(metadata_keys::PARAMETERS))
+    let plant_text = logs
+        .iter()
+        .find(|(k, _)| *k == plant)
+        .and_then(|(_, l)| l.scenario_text.as_deref())
+        .or(peeks[plant].scenario_text.as_deref());
+    let controller_log = controller_path.and_then(|c| logs.iter().find(|(k, _)| *k == c));
+    let mut sources = vec![(paths[plant].as_path(), plant_text)];
+    if let Some((_, l)) = controller_log {
+        sources.push((l.path.as_path(), l.scenario_text.as_deref()));
+    }
+    let (scenario, scenario_source) = scenario_of(&sources, &mut notes)?;
+    let plant_scenario = plant_text.is_some();
+    let params = controller_log
+        .and_then(|(_, l)| l.metadata.get(metadata_keys::PARAMETERS))
         .and_then(|p| serde_json::from_str::<serde_json::Value>(p).ok());
-    if controller_file.is_none() {
+    if controller_path.is_none() {
         notes.push(
             "no controller log: COLREGS situations, commands, solver statistics and bound \
              checks of the commands are missing"
@@ -222,20 +336,37 @@ pub fn assemble(logs: Vec<LogFile>) -> Result<Run> {
         );
     }
 
-    let files = logs.iter().map(summarize).collect();
-    let mut plant = PlantData::default();
-    let mut controller = ControllerData::default();
-    let mut unit_logs = Vec::new();
-    for (k, log) in logs.into_iter().enumerate() {
-        unit_logs.extend(log.logs);
-        if k == plant_idx {
-            plant = log.plant;
-        }
-        if Some(k) == controller_file {
-            controller = log.controller;
+    // Files in the order given; the plant log's entry is replaced after its stream.
+    let mut files = Vec::new();
+    let mut plant_file = 0;
+    for k in 0..paths.len() {
+        if k == plant {
+            plant_file = files.len();
+            files.push(FileSummary {
+                path: paths[k].clone(),
+                unit: Unit::Plant.name(),
+                bytes: peeks[k].bytes,
+                messages: std::collections::BTreeMap::new(),
+                decode_errors: std::collections::BTreeMap::new(),
+                schema_mismatches: Vec::new(),
+                truncated: None,
+                metadata: peeks[k].metadata.clone(),
+            });
+        } else if let Some((_, log)) = logs.iter().find(|(j, _)| *j == k) {
+            files.push(summarize(log));
         }
     }
-    unit_logs.sort_by_key(|l| l.t_ns);
+    let mut controller = ControllerData::default();
+    let mut unit_logs = Vec::new();
+    for (k, log) in logs {
+        if Some(k) == controller_path {
+            controller = log.controller;
+        }
+        // The plant log's unit logs come with its stream.
+        if k != plant {
+            unit_logs.extend(log.logs);
+        }
+    }
 
     let param = |name: &str| -> Option<f64> {
         let v = params.as_ref()?.get(name)?;
@@ -286,13 +417,34 @@ pub fn assemble(logs: Vec<LogFile>) -> Result<Run> {
         architecture,
         scheme,
     };
+    for (path, reason) in empty {
+        notes.push(format!(
+            "{} is truncated before any usable message and was left out",
+            path.display()
+        ));
+        files.push(FileSummary {
+            path,
+            unit: "unknown (truncated)",
+            bytes: 0,
+            messages: std::collections::BTreeMap::new(),
+            decode_errors: std::collections::BTreeMap::new(),
+            schema_mismatches: Vec::new(),
+            truncated: Some(reason),
+            metadata: std::collections::BTreeMap::new(),
+        });
+    }
     Ok(Run {
         files,
-        plant,
+        plant_path: paths[plant].clone(),
+        plant_file,
         controller,
         logs: unit_logs,
         config,
         notes,
+        paths: paths.to_vec(),
+        plant_read_whole,
+        plant_scenario,
+        controller_path,
     })
 }
 
@@ -305,21 +457,19 @@ fn median_step_s(t_ns: &[i64]) -> Option<f64> {
     Some(d[d.len() / 2] as f64 * 1e-9)
 }
 
-/// The scenario attached to the plant log, else the controller's, else the bundled paper
-/// scenario (with a note).
+/// The scenario attached to the plant log, else the controller's (`sources`: each log
+/// and its attachment's text, in that order), else the bundled paper scenario (with a
+/// note).
 fn scenario_of(
-    logs: &[LogFile],
-    plant: usize,
-    controller: Option<usize>,
+    sources: &[(&Path, Option<&str>)],
     notes: &mut Vec<String>,
 ) -> Result<(Scenario, String)> {
-    for k in std::iter::once(plant).chain(controller) {
-        let log = &logs[k];
-        if let Some(text) = &log.scenario_text {
-            let origin = format!("{} (attachment scenario.toml)", log.path.display());
+    for (path, text) in sources {
+        if let Some(text) = text {
+            let origin = format!("{} (attachment scenario.toml)", path.display());
             let scenario =
                 Scenario::from_toml_str(text, &origin).map_err(|e| AnalyzerError::Scenario {
-                    path: log.path.clone(),
+                    path: path.to_path_buf(),
                     reason: e.to_string(),
                 })?;
             return Ok((scenario, origin));

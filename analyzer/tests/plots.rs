@@ -17,7 +17,7 @@ fn plots_decode_with_their_sizes_and_the_map_shows_the_run() {
     common::with_analysis(&run, dir.path(), |a| check_plots(a, dir.path()));
 }
 
-fn check_plots(a: &analyzer::analysis::Analysis<'_>, dir: &std::path::Path) {
+fn check_plots(a: &analyzer::analysis::Analysis, dir: &std::path::Path) {
     let out = dir.join("plots");
     std::fs::create_dir_all(&out).expect("dir");
     let plots = write_plots(&out, &a.plot).expect("plots");

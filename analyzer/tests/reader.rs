@@ -315,3 +315,105 @@ fn a_controller_log_cut_before_its_first_message_is_left_out() {
     let e = analyzer::report(&out, &[controller], true).expect_err("nothing");
     assert!(e.to_string().contains("controller.mcap"), "{e}");
 }
+
+/// A merged log (plant and controller topics in one file, not written by `LogWriter`)
+/// whose controller channel and scenario attachment come only after the first plant
+/// message: the first records say "plant", the stream finds the rest, and the file is read
+/// again whole (once) so nothing is lost.
+#[test]
+fn a_merged_log_with_late_controller_topics_and_scenario_is_read_whole() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("merged.mcap");
+    let scenario = common::straight(10.0, 0.1, 100).scenario_toml();
+    let mut w = mcap::WriteOptions::new()
+        .create(std::io::BufWriter::new(
+            std::fs::File::create(&path).expect("file"),
+        ))
+        .expect("writer");
+    let vs = w
+        .add_schema(VesselState::SCHEMA_NAME, "jsonschema", b"{}")
+        .expect("schema");
+    let ids: Vec<u16> = [names::PLANT_SHIP, names::PLANT_TUG1, names::PLANT_TUG2]
+        .iter()
+        .map(|t| {
+            w.add_channel(vs, t, "json", &BTreeMap::new())
+                .expect("channel")
+        })
+        .collect();
+    let mut solver = None;
+    for k in 0..300u32 {
+        let t = f64::from(k) * 0.1;
+        let ns = u64::from(k) * 100_000_000;
+        let header = |channel_id| mcap::records::MessageHeader {
+            channel_id,
+            sequence: k,
+            log_time: ns,
+            publish_time: ns,
+        };
+        for (j, &id) in ids.iter().enumerate() {
+            let m = VesselState {
+                t,
+                x: 0.1 * t + j as f64,
+                y: 0.0,
+                psi: 0.0,
+                u: 0.1,
+                v: 0.0,
+                r: 0.0,
+            };
+            w.write_to_known_channel(&header(id), &serde_json::to_vec(&m).expect("json"))
+                .expect("write");
+        }
+        if k == 5 {
+            w.attach(&mcap::Attachment {
+                log_time: ns,
+                create_time: ns,
+                name: "scenario.toml".to_owned(),
+                media_type: "application/toml".to_owned(),
+                data: std::borrow::Cow::Borrowed(scenario.as_bytes()),
+            })
+            .expect("attach");
+            let s = w
+                .add_schema(Solver::SCHEMA_NAME, "jsonschema", b"{}")
+                .expect("schema");
+            solver = Some(
+                w.add_channel(s, names::CONTROLLER_SOLVER, "json", &BTreeMap::new())
+                    .expect("channel"),
+            );
+        }
+        if let (Some(id), true) = (solver, k % 10 == 0) {
+            let m = Solver {
+                t,
+                architecture: 2,
+                scheme: 3,
+                iterations: 7,
+                converged: true,
+                r_pri: [1e-3; 2],
+                r_dual: [1e-3; 2],
+                compute_time_ms: 4.0,
+                samples: u64::from(k / 10 + 1),
+                fallbacks: 0,
+                fallback: None,
+            };
+            w.write_to_known_channel(&header(id), &serde_json::to_vec(&m).expect("json"))
+                .expect("write");
+        }
+    }
+    w.finish().expect("finish");
+    drop(w);
+    let peek = analyzer::read::peek_log(&path).expect("peek");
+    assert_eq!(peek.unit, Some(Unit::Plant), "the first records say plant");
+    assert!(peek.scenario_text.is_none());
+    let out = dir.path().join("r");
+    let o = analyzer::report(&out, &[path], true).expect("report");
+    let m = &o.metrics;
+    assert_eq!(m.plant_steps, 300);
+    assert_eq!(m.control_samples, 29, "samples from k = 10 on");
+    assert_eq!(m.architecture.as_ref().map(|a| a.code), Some(2));
+    assert_eq!(m.scenario, "straight", "the late attachment is used");
+    assert_eq!(m.files.len(), 1);
+    assert_eq!(m.files[0].unit, "plant and controller");
+    assert_eq!(m.files[0].messages["/plant/ship"], 300);
+    // Every table exactly once: nothing left from the abandoned first pass.
+    let ts = std::fs::read_to_string(out.join("timeseries.csv")).expect("csv");
+    assert_eq!(ts.lines().count(), 301);
+}

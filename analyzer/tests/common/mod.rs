@@ -3,7 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use analyzer::analysis::{analyze, Analysis, Metrics};
+use analyzer::analysis::{Analysis, Metrics};
+use analyzer::stream::StreamOptions;
 use analyzer::synth::{SynthObstacle, SynthRun, SynthShape};
 
 /// Writes `run` into `dir` and returns the plant and controller log paths.
@@ -14,14 +15,22 @@ pub fn write_logs(run: &SynthRun, dir: &Path) -> (PathBuf, PathBuf) {
     (plant, controller)
 }
 
-/// Writes and analyses `run`, and hands the analysis to `f`.
-pub fn with_analysis<R>(run: &SynthRun, dir: &Path, f: impl FnOnce(&Analysis<'_>) -> R) -> R {
+/// Writes and analyses `run` (no tables written), and hands the analysis to `f`.
+pub fn with_analysis<R>(run: &SynthRun, dir: &Path, f: impl FnOnce(&Analysis) -> R) -> R {
+    with_options(run, dir, &StreamOptions::default(), f)
+}
+
+/// [`with_analysis`] with the streaming analysis' sizes `opts`.
+pub fn with_options<R>(
+    run: &SynthRun,
+    dir: &Path,
+    opts: &StreamOptions,
+    f: impl FnOnce(&Analysis) -> R,
+) -> R {
     let (plant, controller) = write_logs(run, dir);
     let multi = analyzer::progress::multi(true);
     let loaded = analyzer::run::load_run(&[controller, plant], &multi).expect("run");
-    let frames = analyzer::frames::build(loaded.plant, loaded.controller, &loaded.config.route)
-        .expect("frames");
-    let a = analyze(&frames, &loaded.config, loaded.files, loaded.notes, &[]).expect("analysis");
+    let a = analyzer::analysis::analyze_run(loaded, None, &multi, opts).expect("analysis");
     f(&a)
 }
 
