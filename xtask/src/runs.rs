@@ -184,17 +184,22 @@ fn figures(case: &Case) -> &'static [&'static str] {
 pub fn reproduce() -> Result<()> {
     const STEP: &str = "write docs/RESULTS.md";
     let tools = Tools::prepare()?;
-    let out = root().join("out/reproduce");
-    let mut dirs = Vec::new();
+    // Commands run in the repository root (see `run`), so the runs are given paths relative
+    // to it: the generated tables then name the run directories the same on every machine.
+    let relative = Path::new("out/reproduce");
+    let out = root().join(relative);
+    let mut names = Vec::new();
     for case in &PAPER_CASES {
-        let dir = out.join(case.name);
-        tools.run_case(case, &dir, true)?;
-        dirs.push(dir);
+        let name = relative.join(case.name);
+        tools.run_case(case, &name, true)?;
+        names.push(name);
     }
     let compare = out.join("compare");
     let mut cmd = Command::new(&tools.analyzer);
-    cmd.args(["compare", "--quiet", "--out"]).arg(&compare);
-    cmd.args(&dirs);
+    cmd.args(["compare", "--quiet", "--out"])
+        .arg(relative.join("compare"));
+    cmd.args(&names);
+    let dirs: Vec<PathBuf> = names.iter().map(|name| root().join(name)).collect();
     run("analyzer compare", &mut cmd)?;
 
     let tables = std::fs::read_to_string(compare.join("compare.md")).or_else(|e| {
