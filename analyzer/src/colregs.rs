@@ -541,8 +541,9 @@ impl EncounterReport {
         let beta_cpa = relative_bearing(own_p, cpa.own[2], tgt_p).to_degrees();
         let alpha_cpa = relative_bearing(tgt_p, cpa.target[2], own_p).to_degrees();
 
-        // Controller's situation: the first definite one (the held situation), every
-        // distinct one in order, and the role that came with the first definite one.
+        // Controller's situation: the first definite one (neither safe nor unclassified:
+        // the one the guidance holds for the encounter, towing-guidance's reference
+        // system), every distinct one in order, and the role that came with it.
         let (mut situation, mut role, mut reported) = (None, None, Vec::<String>::new());
         if let Some(c) = controller {
             for (k, &code) in c.situation_codes.iter().enumerate() {
@@ -550,7 +551,8 @@ impl EncounterReport {
                     if reported.last().map(String::as_str) != Some(s.name()) {
                         reported.push(s.name().to_owned());
                     }
-                    if situation.is_none() && s != Situation::Safe {
+                    let definite = !matches!(s, Situation::Safe | Situation::Unclassified);
+                    if situation.is_none() && definite {
                         situation = Some(s);
                         role = c.roles.get(k).cloned();
                     }
@@ -908,9 +910,16 @@ mod tests {
         // 30 deg to port: starboard to starboard.
         let good = run(30f64.to_radians(), 140.0, 30.0, -0.5, PI, 0.07, 0.1);
         let bad = run(-30f64.to_radians(), 140.0, 30.0, -0.5, PI, 0.07, 0.1);
+        // Unclassified first (the target far off the bow), then head-on: the held
+        // situation is head-on, as the guidance's.
         let view = ControllerView {
-            situation_codes: vec![0, 1, 1],
-            roles: vec!["none".into(), "give-way".into(), "give-way".into()],
+            situation_codes: vec![0, 6, 1, 1],
+            roles: vec![
+                "none".into(),
+                "none".into(),
+                "give-way".into(),
+                "give-way".into(),
+            ],
         };
         let g = assess("C", 6, &good, Some(&view), &p).expect("report");
         let b = assess("C", 6, &bad, Some(&view), &p).expect("report");

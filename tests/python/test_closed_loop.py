@@ -488,7 +488,7 @@ def test_linear_prediction_model_against_the_nonlinear_plant(plant_fmu, controll
     model (constant damping, the paper's eq. (1)), the plant integrates the nonlinear one
     (Skjetne et al. 2004). The run must finish collision-free with every command within its
     bounds, and settle at the destination (1500 s simulated: it arrives later than with the
-    matched model, about 1190 s against 1145 s)."""
+    matched model, about 1030 s against 995 s)."""
     out = ROOT / "out" / "acceptance" / "mismatch-linear-controller"
     r = run_master(out, "--plant", plant_fmu, "--controller", controller_fmu, "--param", "hull_model=1",
                    "--plant-param", "hull_model=2", "--stop-time", 1500, "--quiet")

@@ -25,7 +25,12 @@
 //!    its detection distance plus `release_margin` (for a static hazard: or the
 //!    alteration no longer helps, on a new segment) (the encounter is over; Rule
 //!    8(d): "until the other vessel is finally past and clear"), even if its
-//!    situation has meanwhile become safe.
+//!    situation has meanwhile become safe; a target ship also releases it, inside
+//!    that distance, once it is past and clear ([`past_and_clear`]: the range from
+//!    every vessel of the tow opening and beyond that vessel's eq. (14) safe range
+//!    plus `release_margin`). Such an encounter stays over until the target leaves
+//!    the encounter distance, unless it closes again into a close-quarters situation
+//!    (Rule 17's TCPA and DCPA limits).
 //! 4. While any obstacle keeps it, the reference is the active waypoint rotated to
 //!    starboard about the previous predefined waypoint (eq. (10)-(11)); otherwise the
 //!    predefined waypoint (eq. (8), `eta_Sd = eta_Sp`).
@@ -35,7 +40,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::colregs::{action, classify, Action, Encounter, Manoeuvre, Situation};
-use crate::distance::{Obstacle, ObstacleInput, ObstacleKind};
+use crate::distance::{Ellipse, Obstacle, ObstacleInput, ObstacleKind};
 use crate::error::InputError;
 use crate::geometry::{dist, segment_distance};
 use crate::params::{GuidanceParams, StaticHazardPolicy};
@@ -123,7 +128,12 @@ pub struct ObstacleAssessment {
     /// [`StaticHazardPolicy::WhenAlteringHelps`], true when the altered leg passes
     /// its centre farther than the route's leg; true otherwise.
     pub alteration_allowed: bool,
-    /// What it asks of the reference system now (detection and Rule 17 applied).
+    /// A target ship that is past and clear (Rule 8(d)): the range from every vessel
+    /// of the tow is opening and exceeds that vessel's eq. (14) safe range plus
+    /// `release_margin` (see [`past_and_clear`]). Always false for a static hazard.
+    pub past_and_clear: bool,
+    /// What it asks of the reference system now (detection, Rule 17 and
+    /// `past_and_clear` applied).
     pub manoeuvre: Manoeuvre,
 }
 
@@ -137,6 +147,10 @@ pub struct AssessContext {
     /// [`StaticHazardPolicy::WhenAlteringHelps`]; without it a static hazard is
     /// judged by distance only.
     pub leg: Option<[[f64; 2]; 3]>,
+    /// This target's encounter was found past and clear at an earlier sample and has
+    /// not ended since (ignored for static hazards): it stays over unless the target
+    /// closes again into a close-quarters situation (see [`past_and_clear`]).
+    pub cleared: bool,
 }
 
 /// Assesses one active obstacle for the tow (steps 1 and 2 of the module doc).
@@ -194,7 +208,17 @@ pub fn assess_obstacle(
         }
         _ => true,
     };
-    let manoeuvre = match (detected && alteration_allowed, &encounter) {
+    let past_and_clear = match (obstacle, &encounter) {
+        (Obstacle::Vessel(target), Some(enc)) => {
+            (context.cleared && !s.colregs.rule17.give_way_failed(&enc.cpa))
+                || past_and_clear(params, tow, &vessels, obstacle, target)
+        }
+        _ => false,
+    };
+    let manoeuvre = match (
+        detected && alteration_allowed && !past_and_clear,
+        &encounter,
+    ) {
         (false, _) => Manoeuvre::FollowRoute,
         (true, None) => Manoeuvre::AlterToStarboard,
         (true, Some(enc)) => policy.manoeuvre(&enc.cpa, &s.colregs.rule17),
@@ -211,8 +235,40 @@ pub fn assess_obstacle(
         action: policy,
         detected,
         alteration_allowed,
+        past_and_clear,
         manoeuvre,
     }
+}
+
+/// Whether target ship `target` is past and clear of the tow (COLREGS Rule 8(d): the
+/// give-way action lasts "until the other vessel is finally past and clear"): for every
+/// vessel of the tow (position `p`, length `l`) the range is opening,
+/// `(p_target - p) . (v_target - v_ship) > 0`, and the range-equivalent distance exceeds
+/// the eq. (14) safe range `L + a_j + d_S0` plus `release_margin`. The tugs are taken
+/// to move with the ship (they hold the formation of eq. (4)-(6)); their own velocity is
+/// not among the guidance's inputs.
+fn past_and_clear(
+    params: &GuidanceParams,
+    tow: &TowState,
+    vessels: &[(TowVessel, [f64; 2], f64); 3],
+    obstacle: &Obstacle,
+    target: &Ellipse,
+) -> bool {
+    let s = params.settings();
+    let v_target = [
+        target.speed * target.psi.cos(),
+        target.speed * target.psi.sin(),
+    ];
+    let dv = [
+        v_target[0] - tow.ship_vel_n[0],
+        v_target[1] - tow.ship_vel_n[1],
+    ];
+    vessels.iter().all(|&(_, p, length)| {
+        let dp = [target.centre[0] - p[0], target.centre[1] - p[1]];
+        let opening = dp[0] * dv[0] + dp[1] * dv[1] > 0.0;
+        opening
+            && obstacle.range(p) > obstacle.safe_range(length, s.safety_buffer) + s.release_margin
+    })
 }
 
 /// Output of one sample.
@@ -264,6 +320,7 @@ pub struct ReferenceSystem {
     params: GuidanceParams,
     active: usize,
     latched: u64,
+    cleared: u64,
     held: [Option<Situation>; MAX_OBSTACLES],
     situations: [Option<Situation>; MAX_OBSTACLES],
 }
@@ -277,6 +334,7 @@ impl ReferenceSystem {
             params,
             active: 1,
             latched: 0,
+            cleared: 0,
             held: [None; MAX_OBSTACLES],
             situations: [None; MAX_OBSTACLES],
         }
@@ -286,6 +344,7 @@ impl ReferenceSystem {
     pub fn reset(&mut self) {
         self.active = 1;
         self.latched = 0;
+        self.cleared = 0;
         self.held = [None; MAX_OBSTACLES];
         self.situations = [None; MAX_OBSTACLES];
     }
@@ -385,6 +444,7 @@ impl ReferenceSystem {
         let mut nearest: Option<ObstacleAssessment> = None;
         let mut nearest_latched: Option<ObstacleAssessment> = None;
         let mut latched = 0u64;
+        let mut cleared = 0u64;
         let mut held = [None; MAX_OBSTACLES];
         let mut situations = [None; MAX_OBSTACLES];
         let points = self.route.points();
@@ -401,9 +461,11 @@ impl ReferenceSystem {
                 Obstacle::Vessel(_) => self.held[index],
                 Obstacle::Circle { .. } => None,
             };
+            let bit = 1u64 << index;
             let context = AssessContext {
                 held: held_before,
                 leg: Some(leg),
+                cleared: self.cleared & bit != 0,
             };
             let a = assess_obstacle(&self.params, tow, index, &obstacle, &context);
             situations[index] = a.situation;
@@ -411,7 +473,6 @@ impl ReferenceSystem {
                 d_ob = a.range;
                 nearest = Some(a);
             }
-            let bit = 1u64 << index;
             let detection = match a.kind {
                 ObstacleKind::Circle => s.static_detection_distance,
                 _ => s.detection_distance,
@@ -421,8 +482,17 @@ impl ReferenceSystem {
                 let definite = !matches!(enc.situation, Situation::Safe | Situation::Unclassified);
                 held[index] = held_before.or((a.detected && definite).then_some(enc.situation));
             }
+            // An encounter found past and clear stays over until it ends (or a new
+            // close-quarters situation arises, in `assess_obstacle`): the tow's own
+            // return to the route must not turn an opening range into a new encounter.
+            if in_encounter && a.past_and_clear && (context.cleared || self.latched & bit != 0) {
+                cleared |= bit;
+            }
             let demands = a.manoeuvre == Manoeuvre::AlterToStarboard;
-            let keeps = self.latched & bit != 0 && in_encounter && a.alteration_allowed;
+            let keeps = self.latched & bit != 0
+                && in_encounter
+                && a.alteration_allowed
+                && !a.past_and_clear;
             if demands || keeps {
                 latched |= bit;
                 if nearest_latched.is_none_or(|n| a.range < n.range) {
@@ -431,6 +501,7 @@ impl ReferenceSystem {
             }
         }
         self.latched = latched;
+        self.cleared = cleared;
         self.held = held;
         self.situations = situations;
         let altered = latched != 0;
@@ -602,28 +673,54 @@ mod tests {
         let tug2 = tow.tug2.x;
         let at = |ahead: f64| [vessel(tug2 + ahead, 0.0, PI, 0.07)];
         assert!(rs.update(&tow, &at(6.0)).unwrap().altered);
-        // The target now astern and opening (Safe), 7.3 m: inside d_D + 0.5 m,
-        // still altered (the encounter is not over).
+        // The target, still closing, now 7.3 m ahead: outside d_D but inside
+        // d_D + 0.5 m, still altered (the encounter is not over).
+        let out = rs.update(&tow, &at(7.3)).unwrap();
+        let g = out.governing.unwrap();
+        assert_eq!(g.situation, Some(Situation::HeadOn));
+        assert!(!g.detected && !g.past_and_clear);
+        assert!(out.altered);
+        assert!(out.eta_sd.y > 0.0);
+        // 7.6 m > 7.5 m: over, back to the predefined waypoint.
+        let out = rs.update(&tow, &at(7.6)).unwrap();
+        assert!(!out.altered);
+        assert_eq!(out.theta, 0.0);
+        assert_eq!(out.eta_sd, Pose::new(30.0, 0.0, 0.0));
+        // A fresh target at 7.3 m (inside the margin but outside d_D) does not alter.
+        let out = rs.update(&tow, &at(7.3)).unwrap();
+        assert!(!out.altered);
+        assert_eq!(out.governing.unwrap().situation, Some(Situation::HeadOn));
+    }
+
+    #[test]
+    fn a_target_past_and_clear_releases_the_alteration_inside_the_detection_distance() {
+        let tow = tow_at(Pose::new(2.0, 0.0, 0.0), 0.1);
+        let ahead = [vessel(tow.tug2.x + 6.0, 0.0, PI, 0.07)];
         let astern = |behind: f64| [vessel(tow.tug1.x - behind, 0.0, PI, 0.07)];
-        let out = rs.update(&tow, &astern(7.3)).unwrap();
+        // Astern and opening, 2.3 m behind tug 1: inside tug 1's safe range plus the
+        // margin (L_T + a_j + d_S0 + 0.5 = 0.97 + 0.74 + 0.25 + 0.5 m), so not clear.
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        assert!(rs.update(&tow, &ahead).unwrap().altered);
+        let out = rs.update(&tow, &astern(2.3)).unwrap();
         let g = out.governing.unwrap();
         assert_eq!(g.encounter.unwrap().situation, Situation::Safe);
         // The encounter's situation is held.
         assert_eq!(g.situation, Some(Situation::HeadOn));
+        assert!(g.detected && !g.past_and_clear);
         assert!(out.altered);
-        assert!(out.eta_sd.y > 0.0);
-        // 7.6 m > 7.5 m: over, back to the predefined waypoint.
-        let out = rs.update(&tow, &astern(7.6)).unwrap();
+        // 3.0 m behind: past (opening from all three vessels) and clear: the
+        // alteration ends although the target is well inside d_D (Rule 8(d)).
+        let out = rs.update(&tow, &astern(3.0)).unwrap();
+        let g = out.governing.unwrap();
+        assert!(g.detected && g.past_and_clear);
+        assert_eq!(g.manoeuvre, Manoeuvre::FollowRoute);
         assert!(!out.altered);
-        assert_eq!(out.theta, 0.0);
         assert_eq!(out.eta_sd, Pose::new(30.0, 0.0, 0.0));
-        // A fresh target at 7.3 m (inside the margin but outside d_D) does not alter,
-        // and no situation is held for it.
-        let out = rs.update(&tow, &at(7.3)).unwrap();
-        assert!(!out.altered);
-        assert_eq!(out.governing.unwrap().situation, Some(Situation::HeadOn));
-        let out = rs.update(&tow, &astern(7.3)).unwrap();
-        assert_eq!(out.governing.unwrap().situation, Some(Situation::Safe));
+        // The same position with the target closing (overtaking the tow at 0.3 m/s)
+        // is not past: the encounter's policy applies again.
+        let overtaking = [vessel(tow.tug1.x - 3.0, 0.0, 0.0, 0.3)];
+        let g = rs.update(&tow, &overtaking).unwrap().governing.unwrap();
+        assert!(!g.past_and_clear);
     }
 
     #[test]
