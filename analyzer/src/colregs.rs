@@ -489,30 +489,12 @@ impl EncounterTracker {
             was_altered: false,
             action: None,
         });
-        let (stbd, port) = (window.stbd, window.port);
-        report.course_change_starboard_deg = Some(stbd);
-        report.course_change_port_deg = Some(port);
-        report.course_change_deg = Some(if stbd >= port { stbd } else { -port });
-        let action = window.action;
-        let r_manoeuvre = match action {
-            Some((t, what, r)) => {
-                report.t_first_action_s = Some(t);
-                report.first_action = Some(what.to_owned());
-                report.r_first_action_m = Some(r);
-                r
-            }
-            None => r_cpa,
-        };
-        judge(
+        conclude(
             &mut report,
             assessed,
-            Manoeuvre {
-                r_manoeuvre,
-                stbd,
-                port,
-                speed_change: (cpa.own[3] - det.own[3]) / det.own[3].abs().max(1e-3),
-                acted: action.is_some(),
-            },
+            (window.stbd, window.port),
+            window.action,
+            (det.own[3], cpa.own[3]),
             p,
         );
         Some(report)
@@ -623,6 +605,35 @@ struct Manoeuvre {
     speed_change: f64,
     /// Whether any action was taken between detection and CPA.
     acted: bool,
+}
+
+/// Records the heading changes `(starboard, port)` (deg) since detection and the first
+/// action `(t, what, range)` in `report`, and judges it ([`judge`]) with the relative speed
+/// change between `speeds` = (own speed at detection, at the CPA). `r_cpa_m` must be set.
+fn conclude(
+    report: &mut EncounterReport,
+    assessed: Option<Situation>,
+    (stbd, port): (f64, f64),
+    action: Option<(f64, &str, f64)>,
+    (speed_detect, speed_cpa): (f64, f64),
+    p: &ScoringParams,
+) {
+    report.course_change_starboard_deg = Some(stbd);
+    report.course_change_port_deg = Some(port);
+    report.course_change_deg = Some(if stbd >= port { stbd } else { -port });
+    if let Some((t, what, r)) = action {
+        report.t_first_action_s = Some(t);
+        report.first_action = Some(what.to_owned());
+        report.r_first_action_m = Some(r);
+    }
+    let manoeuvre = Manoeuvre {
+        r_manoeuvre: action.map_or(report.r_cpa_m, |(_, _, r)| r),
+        stbd,
+        port,
+        speed_change: (speed_cpa - speed_detect) / speed_detect.abs().max(1e-3),
+        acted: action.is_some(),
+    };
+    judge(report, assessed, manoeuvre, p);
 }
 
 /// Scores and verdict of an encounter whose CPA fields (`r_cpa_m`, `alpha_cpa_deg`,
@@ -813,29 +824,12 @@ mod tests {
             }
             was_altered = altered;
         }
-        report.course_change_starboard_deg = Some(stbd);
-        report.course_change_port_deg = Some(port);
-        report.course_change_deg = Some(if stbd >= port { stbd } else { -port });
-        let r_manoeuvre = match action {
-            Some((i, what)) => {
-                report.t_first_action_s = Some(samples[i].t);
-                report.first_action = Some(what.to_owned());
-                let r = range(&samples[i]);
-                report.r_first_action_m = Some(r);
-                r
-            }
-            None => r_cpa,
-        };
-        judge(
+        conclude(
             &mut report,
             assessed,
-            Manoeuvre {
-                r_manoeuvre,
-                stbd,
-                port,
-                speed_change: (cpa.own[3] - det.own[3]) / det.own[3].abs().max(1e-3),
-                acted: action.is_some(),
-            },
+            (stbd, port),
+            action.map(|(i, what)| (samples[i].t, what, range(&samples[i]))),
+            (det.own[3], cpa.own[3]),
             p,
         );
         Some(report)

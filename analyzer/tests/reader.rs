@@ -24,58 +24,62 @@ fn write_raw(path: &Path, steps: usize, chunked: bool) {
             std::fs::File::create(path).expect("file"),
         ))
         .expect("writer");
-    let ship_schema = w
-        .add_schema(VesselState::SCHEMA_NAME, "jsonschema", b"{}")
-        .expect("schema");
+    let ids = vessel_channels(&mut w);
     let solver_schema = w
         .add_schema(Solver::SCHEMA_NAME, "jsonschema", b"{}")
         .expect("schema");
-    let mut ids = Vec::new();
-    for topic in [names::PLANT_SHIP, names::PLANT_TUG1, names::PLANT_TUG2] {
-        ids.push(
-            w.add_channel(ship_schema, topic, "json", &BTreeMap::new())
-                .expect("channel"),
-        );
-    }
     let foreign = w
         .add_channel(solver_schema, "/something/else", "json", &BTreeMap::new())
         .expect("channel");
-    for k in 0..steps {
-        let t = k as f64 * 0.1;
-        let ns = k as u64 * 100_000_000;
-        for (j, &id) in ids.iter().enumerate() {
-            let m = VesselState {
-                t,
-                x: 0.1 * t + j as f64,
-                y: 0.0,
-                psi: 0.0,
-                u: 0.1,
-                v: 0.0,
-                r: 0.0,
-            };
-            w.write_to_known_channel(
-                &mcap::records::MessageHeader {
-                    channel_id: id,
-                    sequence: k as u32,
-                    log_time: ns,
-                    publish_time: ns,
-                },
-                &serde_json::to_vec(&m).expect("json"),
-            )
+    for k in 0..u32::try_from(steps).expect("steps") {
+        write_vessels(&mut w, &ids, k);
+        w.write_to_known_channel(&header(foreign, k), b"{\"anything\": 1}")
             .expect("write");
-        }
-        w.write_to_known_channel(
-            &mcap::records::MessageHeader {
-                channel_id: foreign,
-                sequence: k as u32,
-                log_time: ns,
-                publish_time: ns,
-            },
-            b"{\"anything\": 1}",
-        )
-        .expect("write");
     }
     w.finish().expect("finish");
+}
+
+/// The channels of the three vessels' `VesselState` topics.
+fn vessel_channels<W: std::io::Write + std::io::Seek>(w: &mut mcap::Writer<W>) -> Vec<u16> {
+    let schema = w
+        .add_schema(VesselState::SCHEMA_NAME, "jsonschema", b"{}")
+        .expect("schema");
+    [names::PLANT_SHIP, names::PLANT_TUG1, names::PLANT_TUG2]
+        .iter()
+        .map(|topic| {
+            w.add_channel(schema, topic, "json", &BTreeMap::new())
+                .expect("channel")
+        })
+        .collect()
+}
+
+/// The header of message `k` (t = k * 0.1 s) on `channel_id`.
+fn header(channel_id: u16, k: u32) -> mcap::records::MessageHeader {
+    let ns = u64::from(k) * 100_000_000;
+    mcap::records::MessageHeader {
+        channel_id,
+        sequence: k,
+        log_time: ns,
+        publish_time: ns,
+    }
+}
+
+/// Step `k` of a straight run at 0.1 m/s on the three vessel channels `ids`.
+fn write_vessels<W: std::io::Write + std::io::Seek>(w: &mut mcap::Writer<W>, ids: &[u16], k: u32) {
+    let t = f64::from(k) * 0.1;
+    for (j, &id) in ids.iter().enumerate() {
+        let m = VesselState {
+            t,
+            x: 0.1 * t + j as f64,
+            y: 0.0,
+            psi: 0.0,
+            u: 0.1,
+            v: 0.0,
+            r: 0.0,
+        };
+        w.write_to_known_channel(&header(id, k), &serde_json::to_vec(&m).expect("json"))
+            .expect("write");
+    }
 }
 
 #[test]
@@ -330,39 +334,12 @@ fn a_merged_log_with_late_controller_topics_and_scenario_is_read_whole() {
             std::fs::File::create(&path).expect("file"),
         ))
         .expect("writer");
-    let vs = w
-        .add_schema(VesselState::SCHEMA_NAME, "jsonschema", b"{}")
-        .expect("schema");
-    let ids: Vec<u16> = [names::PLANT_SHIP, names::PLANT_TUG1, names::PLANT_TUG2]
-        .iter()
-        .map(|t| {
-            w.add_channel(vs, t, "json", &BTreeMap::new())
-                .expect("channel")
-        })
-        .collect();
+    let ids = vessel_channels(&mut w);
     let mut solver = None;
     for k in 0..300u32 {
         let t = f64::from(k) * 0.1;
         let ns = u64::from(k) * 100_000_000;
-        let header = |channel_id| mcap::records::MessageHeader {
-            channel_id,
-            sequence: k,
-            log_time: ns,
-            publish_time: ns,
-        };
-        for (j, &id) in ids.iter().enumerate() {
-            let m = VesselState {
-                t,
-                x: 0.1 * t + j as f64,
-                y: 0.0,
-                psi: 0.0,
-                u: 0.1,
-                v: 0.0,
-                r: 0.0,
-            };
-            w.write_to_known_channel(&header(id), &serde_json::to_vec(&m).expect("json"))
-                .expect("write");
-        }
+        write_vessels(&mut w, &ids, k);
         if k == 5 {
             w.attach(&mcap::Attachment {
                 log_time: ns,
@@ -394,7 +371,7 @@ fn a_merged_log_with_late_controller_topics_and_scenario_is_read_whole() {
                 fallbacks: 0,
                 fallback: None,
             };
-            w.write_to_known_channel(&header(id), &serde_json::to_vec(&m).expect("json"))
+            w.write_to_known_channel(&header(id, k), &serde_json::to_vec(&m).expect("json"))
                 .expect("write");
         }
     }

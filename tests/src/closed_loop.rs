@@ -94,9 +94,13 @@ fn kind(v: &VariableType) -> Option<Kind> {
 
 const KINDS: [Kind; 3] = [Kind::Real, Kind::Integer, Kind::Boolean];
 
-/// Per kind (Real, Integer, Boolean): (index into the sender's outputs of that kind, input
-/// value reference).
-type Inputs = [Vec<(usize, u32)>; 3];
+/// The connected inputs per kind (Real, Integer, Boolean): the index of each one's source
+/// among the sender's outputs of that kind, and its value reference (set in one call).
+#[derive(Default)]
+struct Inputs {
+    source: [Vec<usize>; 3],
+    vr: [Vec<u32>; 3],
+}
 
 /// One instance with its outputs (read once per step, by type) and its connected inputs.
 struct Unit {
@@ -110,9 +114,17 @@ struct Unit {
     bools: Vec<i32>,
     /// The connected inputs, fed from the other unit's outputs.
     inputs: Inputs,
+    /// Scratch values of the connected inputs (Real; Integer and Boolean), reused each step.
+    in_reals: Vec<f64>,
+    in_ints: Vec<i32>,
 }
 
-fn check(status: fmi2Status, what: &str, warnings: &mut usize) -> Result<(), String> {
+/// `what` is formatted only for an error (the per-step calls pass `format_args!`).
+fn check(
+    status: fmi2Status,
+    what: impl std::fmt::Display,
+    warnings: &mut usize,
+) -> Result<(), String> {
     match status {
         fmi2Status::Ok => Ok(()),
         fmi2Status::Warning => {
@@ -145,62 +157,60 @@ impl Unit {
             bools: vec![0; out_vr[2].len()],
             out_names,
             out_vr,
-            inputs: Default::default(),
+            inputs: Inputs::default(),
+            in_reals: Vec::new(),
+            in_ints: Vec::new(),
         }
     }
 
+    /// Reads the outputs by type; stops at the first call that fails.
     fn read_outputs(&mut self, warnings: &mut usize) -> Result<(), String> {
-        let what = format!("{}: reading outputs", self.name);
-        check(
-            self.fmu.getReal(&self.out_vr[0], &mut self.reals),
-            &what,
-            warnings,
-        )?;
-        check(
-            self.fmu.getInteger(&self.out_vr[1], &mut self.ints),
-            &what,
-            warnings,
-        )?;
-        check(
-            self.fmu.getBoolean(&self.out_vr[2], &mut self.bools),
-            &what,
-            warnings,
-        )
+        let name = self.name;
+        let status = self.fmu.getReal(&self.out_vr[0], &mut self.reals);
+        check(status, format_args!("{name}: reading outputs"), warnings)?;
+        let status = self.fmu.getInteger(&self.out_vr[1], &mut self.ints);
+        check(status, format_args!("{name}: reading outputs"), warnings)?;
+        let status = self.fmu.getBoolean(&self.out_vr[2], &mut self.bools);
+        check(status, format_args!("{name}: reading outputs"), warnings)
     }
 
     /// Sets this unit's connected inputs from `sender`'s last outputs (or to 0).
-    fn take_inputs(&self, sender: Option<&Unit>, warnings: &mut usize) -> Result<(), String> {
-        let what = format!("{}: setting inputs", self.name);
+    fn take_inputs(&mut self, sender: Option<&Unit>, warnings: &mut usize) -> Result<(), String> {
         for k in KINDS {
-            let c = &self.inputs[k as usize];
-            if c.is_empty() {
+            let (source, vrs) = (&self.inputs.source[k as usize], &self.inputs.vr[k as usize]);
+            if vrs.is_empty() {
                 continue;
             }
-            let vrs: Vec<u32> = c.iter().map(|(_, vr)| *vr).collect();
-            let status = match k {
-                Kind::Real => {
-                    let v: Vec<f64> = c
-                        .iter()
-                        .map(|(i, _)| sender.map_or(0.0, |s| s.reals[*i]))
-                        .collect();
-                    self.fmu.setReal(&vrs, &v)
+            let status = if k == Kind::Real {
+                self.in_reals.clear();
+                self.in_reals
+                    .extend(source.iter().map(|&i| sender.map_or(0.0, |s| s.reals[i])));
+                self.fmu.setReal(vrs, &self.in_reals)
+            } else {
+                fn int_outputs(s: &Unit, k: Kind) -> &[i32] {
+                    if k == Kind::Integer {
+                        &s.ints
+                    } else {
+                        &s.bools
+                    }
                 }
-                Kind::Integer => {
-                    let v: Vec<i32> = c
+                self.in_ints.clear();
+                self.in_ints.extend(
+                    source
                         .iter()
-                        .map(|(i, _)| sender.map_or(0, |s| s.ints[*i]))
-                        .collect();
-                    self.fmu.setInteger(&vrs, &v)
-                }
-                Kind::Boolean => {
-                    let v: Vec<i32> = c
-                        .iter()
-                        .map(|(i, _)| sender.map_or(0, |s| s.bools[*i]))
-                        .collect();
-                    self.fmu.setBoolean(&vrs, &v)
+                        .map(|&i| sender.map_or(0, |s| int_outputs(s, k)[i])),
+                );
+                if k == Kind::Integer {
+                    self.fmu.setInteger(vrs, &self.in_ints)
+                } else {
+                    self.fmu.setBoolean(vrs, &self.in_ints)
                 }
             };
-            check(status, &what, warnings)?;
+            check(
+                status,
+                format_args!("{}: setting inputs", self.name),
+                warnings,
+            )?;
         }
         Ok(())
     }
@@ -226,7 +236,7 @@ fn connect(
     receiver_md: &ModelDescription,
     receiver_name: &str,
 ) -> Result<(Inputs, Vec<String>), String> {
-    let mut inputs: Inputs = Default::default();
+    let mut inputs = Inputs::default();
     let mut names = Vec::new();
     let mut problems = Vec::new();
     for input in receiver_md
@@ -256,7 +266,8 @@ fn connect(
                     .iter()
                     .position(|n| *n == input.name)
                     .ok_or_else(|| format!("{}: output '{}' not found", sender.name, input.name))?;
-                inputs[k as usize].push((index, input.valueReference));
+                inputs.source[k as usize].push(index);
+                inputs.vr[k as usize].push(input.valueReference);
                 names.push(input.name.clone());
             }
         }
@@ -363,14 +374,14 @@ pub fn run_closed_loop(
             Coupling::GaussSeidel => {
                 check(
                     ctrl.fmu.doStep(t, step, 1),
-                    &format!("controller: doStep at t = {t} s"),
+                    format_args!("controller: doStep at t = {t} s"),
                     w,
                 )?;
                 ctrl.read_outputs(w)?;
                 plant.take_inputs(Some(&ctrl), w)?;
                 check(
                     plant.fmu.doStep(t, step, 1),
-                    &format!("plant: doStep at t = {t} s"),
+                    format_args!("plant: doStep at t = {t} s"),
                     w,
                 )?;
             }
@@ -379,12 +390,12 @@ pub fn run_closed_loop(
                 plant.take_inputs(ctrl_out, w)?;
                 check(
                     ctrl.fmu.doStep(t, step, 1),
-                    &format!("controller: doStep at t = {t} s"),
+                    format_args!("controller: doStep at t = {t} s"),
                     w,
                 )?;
                 check(
                     plant.fmu.doStep(t, step, 1),
-                    &format!("plant: doStep at t = {t} s"),
+                    format_args!("plant: doStep at t = {t} s"),
                     w,
                 )?;
                 ctrl.read_outputs(w)?;

@@ -40,7 +40,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::colregs::{action, classify, Action, Encounter, Manoeuvre, Situation};
-use crate::distance::{Ellipse, Obstacle, ObstacleInput, ObstacleKind};
+use crate::distance::{Obstacle, ObstacleInput, ObstacleKind};
 use crate::error::InputError;
 use crate::geometry::{dist, segment_distance};
 use crate::params::{GuidanceParams, StaticHazardPolicy};
@@ -208,13 +208,10 @@ pub fn assess_obstacle(
         }
         _ => true,
     };
-    let past_and_clear = match (obstacle, &encounter) {
-        (Obstacle::Vessel(target), Some(enc)) => {
-            (context.cleared && !s.colregs.rule17.give_way_failed(&enc.cpa))
-                || past_and_clear(params, tow, &vessels, obstacle, target)
-        }
-        _ => false,
-    };
+    let past_and_clear = encounter.is_some_and(|enc| {
+        (context.cleared && !s.colregs.rule17.give_way_failed(&enc.cpa))
+            || past_and_clear(params, tow, &vessels, obstacle)
+    });
     let manoeuvre = match (
         detected && alteration_allowed && !past_and_clear,
         &encounter,
@@ -240,7 +237,7 @@ pub fn assess_obstacle(
     }
 }
 
-/// Whether target ship `target` is past and clear of the tow (COLREGS Rule 8(d): the
+/// Whether `obstacle`, a target ship, is past and clear of the tow (false for a static hazard) (COLREGS Rule 8(d): the
 /// give-way action lasts "until the other vessel is finally past and clear"): for every
 /// vessel of the tow (position `p`, length `l`) the range is opening,
 /// `(p_target - p) . (v_target - v_ship) > 0`, and the range-equivalent distance exceeds
@@ -252,8 +249,10 @@ fn past_and_clear(
     tow: &TowState,
     vessels: &[(TowVessel, [f64; 2], f64); 3],
     obstacle: &Obstacle,
-    target: &Ellipse,
 ) -> bool {
+    let Obstacle::Vessel(target) = obstacle else {
+        return false;
+    };
     let s = params.settings();
     let v_target = [
         target.speed * target.psi.cos(),
