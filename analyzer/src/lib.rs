@@ -37,6 +37,8 @@ pub mod run;
 pub mod step;
 pub mod stream;
 pub mod synth;
+pub mod thresholds;
+pub mod verdict;
 
 pub use compare::compare;
 pub use error::{AnalyzerError, Result};
