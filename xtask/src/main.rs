@@ -8,6 +8,8 @@
 //! cargo xtask test                the README's test command: everything CI checks
 //! cargo xtask demo                the README's main command (out/paper/report.html)
 //! cargo xtask reproduce           the paper's six runs and docs/RESULTS.md
+//! cargo xtask campaign FILE --out DIR [--workers N] [--scheduler ADDRESS] [--resume]
+//!                                 many runs on Dask, judged by the analyzer (docs/campaigns.md)
 //! ```
 //!
 //! Every step prints what it does; a failing step names itself and the reason.
@@ -17,6 +19,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
+mod campaign;
 mod fmu;
 mod python;
 mod runs;
@@ -162,7 +165,11 @@ commands:
   demo                package both FMUs, run the closed loop on the paper scenario under fmpy with
                       MCAP logs and the analyzer's report (writes out/paper/report.html)
   reproduce           the paper's runs (distributed and centralized, schemes I, II, III) into
-                      out/reproduce/, analyzer compare, and docs/RESULTS.md's tables and figures";
+                      out/reproduce/, analyzer compare, and docs/RESULTS.md's tables and figures
+  campaign FILE --out DIR [--workers N] [--scheduler ADDRESS] [--resume]
+                      the campaign file's runs (scenarios x parameter values) on Dask, each judged
+                      by the analyzer's verdict: DIR/summary.json, runs.parquet, report.html
+                      (docs/campaigns.md)";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -174,6 +181,7 @@ fn main() -> ExitCode {
         Some("test") => test_all(),
         Some("demo") => runs::demo(),
         Some("reproduce") => runs::reproduce(),
+        Some("campaign") => campaign::campaign(&args[1..]),
         Some("-h" | "--help" | "help") => {
             progress(USAGE);
             Ok(())
