@@ -66,7 +66,8 @@ pub fn campaign(args: &[String]) -> Result<()> {
     let options = parse(args).or_else(|e| fail(STEP, format!("{e}\n{USAGE}")))?;
     // Paths as the user gave them, relative to where cargo was started (commands run in
     // the repository root).
-    let cwd = std::env::current_dir().or_else(|e| fail(STEP, format!("no current directory: {e}")))?;
+    let cwd =
+        std::env::current_dir().or_else(|e| fail(STEP, format!("no current directory: {e}")))?;
     let fmus = fmu::package_all()?;
     let find = |model: &str| {
         fmus.iter()
@@ -115,7 +116,14 @@ mod tests {
 
     #[test]
     fn options_are_parsed_and_bad_ones_named() {
-        let o = parse(&args(&["c.toml", "--out", "o", "--workers", "2", "--resume"]));
+        let o = parse(&args(&[
+            "c.toml",
+            "--out",
+            "o",
+            "--workers",
+            "2",
+            "--resume",
+        ]));
         assert_eq!(
             o,
             Ok(Options {
