@@ -355,19 +355,41 @@ def start_client(args):
     return Client(cluster), cluster
 
 
+class ByValue:
+    """A function that pickles as its code (cloudpickle, by value), for a scheduler and
+    workers that cannot import its module. Dask pickles a task graph with plain pickle when
+    it can, which writes a module function as a reference by name, whatever cloudpickle's
+    registry says; this wrapper's __reduce__ hands pickle the function's cloudpickle bytes
+    and `cloudpickle.loads` (importable wherever Dask is) to rebuild it."""
+
+    def __init__(self, fn):
+        import cloudpickle
+
+        cloudpickle.register_pickle_by_value(sys.modules[fn.__module__])
+        self.fn = fn
+        self.payload = cloudpickle.dumps(fn)
+
+    def __call__(self, *args, **kwargs):
+        return self.fn(*args, **kwargs)
+
+    def __reduce__(self):
+        import cloudpickle
+
+        return cloudpickle.loads, (self.payload,)
+
+
 def execute_all(todo, c, bundle, args, out, on_record):
     """Submits every run of `todo` as a task and stores each result as it returns."""
-    import cloudpickle
     from distributed import as_completed
 
     # The workers may not have the repository: the task module goes with the tasks by value.
-    cloudpickle.register_pickle_by_value(campaign_task)
+    task = ByValue(campaign_task.execute)
     client, cluster = start_client(args)
     try:
         [bundle_future] = client.scatter([bundle], broadcast=True)
         futures = {}
         for run in todo:
-            f = client.submit(campaign_task.execute, spec_of(run, c), bundle_future, run["bytes"], key=f"run-{run['id']}", pure=False)
+            f = client.submit(task, spec_of(run, c), bundle_future, run["bytes"], key=f"run-{run['id']}", pure=False)
             futures[f] = run
         for f in as_completed(futures):
             run = futures[f]
