@@ -700,7 +700,7 @@ def extra_specs():
         _extra("extra-09-turn-90", ["a 90 deg starboard turn halfway (North 22.5 m, then East 22.5 m): a target",
                "crossing from port before the turn and a head-on target after it."], [(0.0, 22.5), (90.0, 22.5)], 5.0, lambda r: ([
             aim(r, "A", 12.0, 90.0, 0.08, 120.0, notes=["Crossing at right angles from port on the first leg, 0.08 m/s."]),
-            aim(r, "B", 33.0, -90.0, 0.10, 90.0, notes=["Reciprocal to the second leg (West), 0.10 m/s, appears once the tow has turned."])], [])),
+            aim(r, "B", 33.0, -90.0, 0.10, 60.0, notes=["Reciprocal to the second leg (West), 0.10 m/s, appears once the tow is 4.4 m into the second leg."])], [])),
         _extra("extra-10-slow-crossing-port", ["a slow target (0.05 m/s) crossing from port."], north, 5.0, lambda r: ([
             aim(r, "A", 25.0, 90.0, 0.05, 160.0, notes=["Crossing at right angles from port, 0.05 m/s."])], [])),
         _extra("extra-11-fast-crossing-starboard", ["a fast target (0.15 m/s) crossing from starboard."], north, 5.0, lambda r: ([
