@@ -248,7 +248,7 @@ class TargetCheck:
     cpa_ship: float = math.inf  # m
     t_cpa_ship: float = math.nan  # s
     cpa_tow: float = math.inf  # m, to the nearest of the three vessels
-    t_cpa_tow: float = math.nan
+    t_cpa_tow: float = math.nan  # s, the first time within 1 cm of cpa_tow
     vessel_cpa_tow: str = ""
 
     @property
@@ -317,9 +317,11 @@ def check_scenario(scenario, speed=CRUISE_SPEED):
             chk.cpa_ship, chk.t_cpa_ship = float(dist["ship"][i]), float(tt[i])
             tow = np.stack([dist[v] for v in tow_geometry.VESSELS])  # (3, T)
             nearest = tow.min(axis=0)
-            j = int(np.flatnonzero(nearest <= nearest.min() + 0.01)[0])  # the earliest of minima equal within 1 cm
+            # The smallest distance; when and to which vessel: the first time within 1 cm of
+            # it (a target on the route passes every vessel at nearly the same distance).
+            j = int(np.flatnonzero(nearest <= nearest.min() + 0.01)[0])
             v = int(np.argmin(tow[:, j]))
-            chk.cpa_tow, chk.t_cpa_tow, chk.vessel_cpa_tow = float(tow[v, j]), float(tt[j]), tow_geometry.VESSELS[v]
+            chk.cpa_tow, chk.t_cpa_tow, chk.vessel_cpa_tow = float(nearest.min()), float(tt[j]), tow_geometry.VESSELS[v]
         found.append(chk)
     return found
 
@@ -484,7 +486,8 @@ def _body(spec):
         f"half_width = {num(spec.half_width, 2)}",
     ]
     for h in spec.hazards:
-        out += ["", "[[obstacles]]", f'name = "{h.name}"', 'kind = "static"', f"x = {num(h.x)}", f"y = {num(h.y)}", f"diameter = {num(h.diameter, 2)}"]
+        out += ["", "[[obstacles]]", f'name = "{h.name}"', 'kind = "static"']
+        out += [f"x = {num(h.x)}", f"y = {num(h.y)}", f"diameter = {num(h.diameter, 2)}"]
     for t in spec.targets:
         out += [
             "",
@@ -700,7 +703,8 @@ def extra_specs():
         _extra("extra-09-turn-90", ["a 90 deg starboard turn halfway (North 22.5 m, then East 22.5 m): a target",
                "crossing from port before the turn and a head-on target after it."], [(0.0, 22.5), (90.0, 22.5)], 5.0, lambda r: ([
             aim(r, "A", 12.0, 90.0, 0.08, 120.0, notes=["Crossing at right angles from port on the first leg, 0.08 m/s."]),
-            aim(r, "B", 33.0, -90.0, 0.10, 60.0, notes=["Reciprocal to the second leg (West), 0.10 m/s, appears once the tow is 4.4 m into the second leg."])], [])),
+            aim(r, "B", 33.0, -90.0, 0.10, 60.0, notes=[
+                "Reciprocal to the second leg (West), 0.10 m/s, appears once the tow is 4.4 m into the second leg."])], [])),
         _extra("extra-10-slow-crossing-port", ["a slow target (0.05 m/s) crossing from port."], north, 5.0, lambda r: ([
             aim(r, "A", 25.0, 90.0, 0.05, 160.0, notes=["Crossing at right angles from port, 0.05 m/s."])], [])),
         _extra("extra-11-fast-crossing-starboard", ["a fast target (0.15 m/s) crossing from starboard."], north, 5.0, lambda r: ([
@@ -766,7 +770,8 @@ def _random_hazard(rng, route, collision_points):
         h = _beside(route, s, offset, "hazard", [])
         if route.distance_to(h.x, h.y) >= 2.5 - 1e-3:
             side = "starboard" if offset > 0 else "port"
-            h.notes = [f"Diameter 1 m, {abs(offset):.2f} m to {side} of the route at {s:.2f} m along (near target {'ABC'[k]}'s collision point)."]
+            near = f"near target {'ABC'[k]}'s collision point"
+            h.notes = [f"Diameter 1 m, {abs(offset):.2f} m to {side} of the route at {s:.2f} m along ({near})."]
             return h
     raise RuntimeError(f"no hazard 2.5 m clear of the route in {RANDOM_ATTEMPTS} draws")
 
