@@ -8,14 +8,14 @@
 //! the target's bow (contact angle). Own ship is the towed ship (the tow's COLREGS
 //! identity, `docs/colregs.md`); its course is its heading.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::geometry::{relative_bearing, wrap};
 
 /// Range and scoring parameters. The published values are full scale (e.g. `r_min`
 /// 100 m, `r_nm` 50 m, `r_col` 30 m); [`ScoringParams::model_scale`] derives them from
 /// the vessels' sizes with the same ratios, see `docs/analyzer.md`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ScoringParams {
     /// Detection range `r_detect`, m: the controller's detection distance `d_D`.
     pub r_detect_m: f64,
@@ -125,7 +125,7 @@ pub fn classify(beta_deg: f64, alpha_deg: f64, own_speed: f64, target_speed: f64
 }
 
 /// The rule scores (each in `[0, 1]`, 1 best) and their parts.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Scores {
     /// Range part `s_r` at the CPA.
     pub s_range: f64,
@@ -163,7 +163,7 @@ pub struct Scores {
 }
 
 /// Everything reported for one target-ship encounter.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EncounterReport {
     /// Target name (scenario).
     pub target: String,

@@ -4,12 +4,14 @@
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
-use serde_json::Value;
 
-use crate::analysis::{architecture_name, scheme_name};
 use crate::doc::{to_html, to_markdown, Block};
 use crate::error::{AnalyzerError, Result};
+use crate::metric::distances::ObstacleDistance;
+use crate::metric::run_info::{architecture_name, scheme_name};
+use crate::metric::Metrics;
 use crate::paper::{self, SCENARIO_CAPTIONS, SCENARIO_TARGETS};
+use crate::rows::VESSELS;
 
 /// The parts of one run's `metrics.json` the tables use.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -37,37 +39,22 @@ pub struct RunSummary {
 }
 
 impl RunSummary {
-    /// Reads the summary from a parsed `metrics.json`. Scenario `k` is the target ship
+    /// Reads the summary from a run's typed metrics. Scenario `k` is the target ship
     /// named as the paper's (A, B, C) if present, else the `k`-th target ship by slot.
     #[must_use]
-    pub fn from_json(run: &str, m: &Value) -> RunSummary {
-        let code = |key: &str| {
-            m.get(key)
-                .and_then(|v| v.get("code"))
-                .and_then(Value::as_i64)
-                .and_then(|v| i32::try_from(v).ok())
-        };
-        let empty = Vec::new();
-        let distances = m
-            .get("normalized_min_distance")
-            .and_then(Value::as_array)
-            .unwrap_or(&empty);
-        let mut ships: Vec<&Value> = distances
+    pub fn from_metrics(run: &str, m: &Metrics) -> RunSummary {
+        let mut ships: Vec<&ObstacleDistance> = m
+            .distances
+            .normalized_min_distance
             .iter()
-            .filter(|o| o.get("kind").and_then(Value::as_str) == Some("ship"))
+            .filter(|o| o.kind == "ship")
             .collect();
-        ships.sort_by_key(|o| o.get("slot").and_then(Value::as_u64).unwrap_or(u64::MAX));
-        let name_of = |o: &Value| {
-            o.get("obstacle")
-                .and_then(Value::as_str)
-                .unwrap_or("")
-                .to_owned()
-        };
-        let by_paper_names: Vec<Option<&Value>> = SCENARIO_TARGETS
+        ships.sort_by_key(|o| o.slot);
+        let by_paper_names: Vec<Option<&ObstacleDistance>> = SCENARIO_TARGETS
             .iter()
-            .map(|n| ships.iter().copied().find(|o| name_of(o) == *n))
+            .map(|n| ships.iter().copied().find(|o| o.obstacle == *n))
             .collect();
-        let chosen: Vec<Option<&Value>> = if by_paper_names.iter().all(Option::is_some) {
+        let chosen: Vec<Option<&ObstacleDistance>> = if by_paper_names.iter().all(Option::is_some) {
             by_paper_names
         } else {
             (0..3).map(|k| ships.get(k).copied()).collect()
@@ -75,41 +62,34 @@ impl RunSummary {
         let mut targets: [Option<String>; 3] = Default::default();
         let mut d = [[None; 3]; 3];
         let mut colregs = [None; 3];
-        let encounters = m.get("colregs").and_then(Value::as_array).unwrap_or(&empty);
         for (k, o) in chosen.iter().enumerate() {
             let Some(o) = o else { continue };
-            let name = name_of(o);
-            for (j, v) in ["ship", "tug1", "tug2"].iter().enumerate() {
-                d[k][j] = o
-                    .get("vessels")
-                    .and_then(|vs| vs.get(*v))
-                    .and_then(|x| x.get("normalized"))
-                    .and_then(Value::as_f64);
+            for (j, v) in VESSELS.iter().enumerate() {
+                d[k][j] = o.vessels.get(*v).map(|x| x.normalized);
             }
-            colregs[k] = encounters
+            colregs[k] = m
+                .colregs
+                .colregs
                 .iter()
-                .find(|e| e.get("target").and_then(Value::as_str) == Some(name.as_str()))
-                .and_then(|e| e.get("verdict").and_then(Value::as_str))
-                .and_then(|v| match v {
+                .find(|e| e.target == o.obstacle)
+                .and_then(|e| match e.verdict.as_str() {
                     "compliant" => Some(true),
                     "violation" => Some(false),
                     _ => None,
                 });
-            targets[k] = Some(name);
+            targets[k] = Some(o.obstacle.clone());
         }
-        let elong = m.get("max_towline_elongation_error");
-        let e = |k: usize| elong.and_then(|a| a.get(k)).and_then(Value::as_f64);
         RunSummary {
             run: run.to_owned(),
-            architecture: code("architecture"),
-            scheme: code("scheme"),
+            architecture: m.run.architecture.as_ref().map(|c| c.code),
+            scheme: m.run.scheme.as_ref().map(|c| c.code),
             targets,
             d,
             colregs,
-            settling_time_s: m.get("settling_time_s").and_then(Value::as_f64),
-            elongation: [e(0), e(1)],
-            ship_travel_m: m.get("ship_travel_m").and_then(Value::as_f64),
-            truncated: m.get("truncated").and_then(Value::as_bool).unwrap_or(false),
+            settling_time_s: m.settling.settling_time_s,
+            elongation: m.elongation.max_towline_elongation_error,
+            ship_travel_m: Some(m.travel.ship_travel_m).filter(|v| v.is_finite()),
+            truncated: m.run.truncated,
         }
     }
 
@@ -127,14 +107,7 @@ impl RunSummary {
     }
 }
 
-/// A number with `prec` decimals or a dash.
-#[must_use]
-pub fn num(v: Option<f64>, prec: usize) -> String {
-    match v {
-        Some(v) if v.is_finite() => format!("{v:.prec$}"),
-        _ => "-".to_owned(),
-    }
-}
+pub use crate::doc::num;
 
 /// A signed difference or a dash.
 #[must_use]
@@ -330,7 +303,7 @@ pub struct CompareOutcome {
     pub written: Vec<PathBuf>,
 }
 
-fn read_metrics(dir: &Path) -> Result<Value> {
+fn read_metrics(dir: &Path) -> Result<Metrics> {
     let path = if dir.is_file() {
         dir.to_owned()
     } else {
@@ -340,18 +313,16 @@ fn read_metrics(dir: &Path) -> Result<Value> {
         path: path.clone(),
         reason: format!("cannot read: {e} (give a directory written by `analyzer report`)"),
     })?;
-    let v: Value = serde_json::from_str(&text).map_err(|e| AnalyzerError::Metrics {
-        path: path.clone(),
-        reason: format!("not a metrics.json: {e}"),
-    })?;
-    if v.get("normalized_min_distance").is_none() {
+    if let Err(e) = serde_json::from_str::<serde::de::IgnoredAny>(&text) {
         return Err(AnalyzerError::Metrics {
             path,
-            reason: "not a metrics.json of `analyzer report` (no normalized_min_distance)"
-                .to_owned(),
+            reason: format!("not a metrics.json: {e}"),
         });
     }
-    Ok(v)
+    serde_json::from_str(&text).map_err(|e| AnalyzerError::Metrics {
+        path,
+        reason: format!("not a metrics.json of `analyzer report`: {e}"),
+    })
 }
 
 /// Writes `compare.md`, `compare.html` and `compare.json` into `out`.
@@ -366,8 +337,8 @@ pub fn compare(out: &Path, dirs: &[PathBuf]) -> Result<CompareOutcome> {
     }
     let mut runs = Vec::new();
     for d in dirs {
-        let v = read_metrics(d)?;
-        runs.push(RunSummary::from_json(&d.display().to_string(), &v));
+        let m = read_metrics(d)?;
+        runs.push(RunSummary::from_metrics(&d.display().to_string(), &m));
     }
     // Order: distributed before centralized, then by scheme.
     runs.sort_by_key(|r| (r.architecture.unwrap_or(9), r.scheme.unwrap_or(9)));

@@ -2,6 +2,15 @@
 
 use std::fmt::Write as _;
 
+/// A number with `prec` decimals or a dash.
+#[must_use]
+pub fn num(v: Option<f64>, prec: usize) -> String {
+    match v {
+        Some(v) if v.is_finite() => format!("{v:.prec$}"),
+        _ => "-".to_owned(),
+    }
+}
+
 /// A block of a report.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Block {

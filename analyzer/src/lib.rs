@@ -11,11 +11,15 @@
 //! published figures.
 //!
 //! Modules, in the order of the data flow: [`read`] (MCAP to messages and columns),
-//! [`run`] (which log is which, the controller's data, scenario, bounds), [`stream`] (the
-//! plant log in batches), [`frames`] (DataFrames, as-of joins), [`metrics`], [`colregs`]
-//! and [`geometry`] (pure computations, each metric as a batch formula and an incremental
-//! tracker), [`decimate`] (plot series of bounded size), [`analysis`] (batches to metrics
-//! and plot data), [`plots`], [`report`], [`compare`].
+//! [`run`] (which log is which, the controller's data, scenario, bounds), [`frames`]
+//! (DataFrames, as-of joins), [`rows`] (a batch's typed [`step::PlantStep`]s),
+//! [`metric`] (one module per metric behind [`metric::Metric`], and the registry that
+//! generates the typed [`metric::Metrics`] and the verdict), [`plot_sink`] (plot series
+//! of bounded size, [`decimate`]), [`stream`] (the plant log in batches through the
+//! metrics and the plot sink), [`analysis`] (a run to metrics and plot data), [`plots`],
+//! [`report`], [`compare`]. [`metrics`], [`colregs`] and [`geometry`] are the pure
+//! computations the metric modules use; [`verdict`] and [`thresholds`] the verdict's
+//! types.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -27,12 +31,15 @@ pub mod doc;
 pub mod error;
 pub mod frames;
 pub mod geometry;
+pub mod metric;
 pub mod metrics;
 pub mod paper;
+pub mod plot_sink;
 pub mod plots;
 pub mod progress;
 pub mod read;
 pub mod report;
+pub mod rows;
 pub mod run;
 pub mod step;
 pub mod stream;

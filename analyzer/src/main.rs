@@ -24,6 +24,10 @@ enum Command {
         /// No progress bars.
         #[arg(long, short)]
         quiet: bool,
+        /// Thresholds of the verdict (TOML, any subset of the keys; docs/analyzer.md,
+        /// "Verdict"); the defaults without it.
+        #[arg(long, value_name = "FILE")]
+        thresholds: Option<PathBuf>,
         /// The run's MCAP logs (plant and controller).
         #[arg(required = true)]
         logs: Vec<PathBuf>,
@@ -50,10 +54,15 @@ fn main() -> ExitCode {
     }));
     let cli = Cli::parse();
     match cli.command {
-        Command::Report { out, quiet, logs } => match analyzer::report(&out, &logs, quiet) {
+        Command::Report {
+            out,
+            quiet,
+            thresholds,
+            logs,
+        } => match report(&out, &logs, quiet, thresholds.as_deref()) {
             Ok(outcome) => {
                 let m = &outcome.metrics;
-                for t in &m.truncated_files {
+                for t in &m.run.truncated_files {
                     eprintln!(
                         "warning: {}: {}; the report covers what was read",
                         t.file, t.reason
@@ -63,7 +72,7 @@ fn main() -> ExitCode {
                     "report written to {} ({} files){}",
                     out.display(),
                     outcome.written.len(),
-                    if m.truncated {
+                    if m.run.truncated {
                         ", from a TRUNCATED log"
                     } else {
                         ""
@@ -71,15 +80,24 @@ fn main() -> ExitCode {
                 );
                 println!(
                     "settling time: {}; max elongation error: {} / {}; ship travel {:.2} m; collisions {}; bound violations {}; fallbacks {}",
-                    m.settling_time_s
+                    m.settling
+                        .settling_time_s
                         .map_or_else(|| "never settled".to_owned(), |t| format!("{t:.1} s")),
-                    pct(m.max_towline_elongation_error[0]),
-                    pct(m.max_towline_elongation_error[1]),
-                    m.ship_travel_m,
-                    m.collisions,
-                    m.bound_violations.report.total,
-                    m.fallbacks
+                    pct(m.elongation.max_towline_elongation_error[0]),
+                    pct(m.elongation.max_towline_elongation_error[1]),
+                    m.travel.ship_travel_m,
+                    m.collisions.collisions,
+                    m.bounds.bound_violations.report.total,
+                    m.solver.fallbacks
                 );
+                if m.verdict.passed {
+                    println!("verdict: passed");
+                } else {
+                    println!("verdict: FAILED ({} reasons)", m.verdict.reasons.len());
+                    for r in &m.verdict.reasons {
+                        println!("  {}", r.line());
+                    }
+                }
                 ExitCode::SUCCESS
             }
             Err(e) => {
@@ -108,6 +126,26 @@ fn main() -> ExitCode {
     }
 }
 
+/// `analyzer report` with the thresholds of `thresholds` (a TOML file) or the defaults.
+fn report(
+    out: &std::path::Path,
+    logs: &[PathBuf],
+    quiet: bool,
+    thresholds: Option<&std::path::Path>,
+) -> analyzer::Result<analyzer::report::ReportOutcome> {
+    let thresholds = match thresholds {
+        Some(path) => analyzer::thresholds::Thresholds::from_file(path)?,
+        None => analyzer::thresholds::Thresholds::default(),
+    };
+    analyzer::report::report_with(
+        out,
+        logs,
+        quiet,
+        &analyzer::stream::StreamOptions::default(),
+        &thresholds,
+    )
+}
+
 fn pct(v: Option<f64>) -> String {
-    v.map_or_else(|| "-".to_owned(), |v| format!("{:.2} %", v * 100.0))
+    analyzer::metric::elongation::pct(v)
 }

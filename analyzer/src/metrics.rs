@@ -9,7 +9,7 @@
 
 use std::borrow::Cow;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::geometry::{dist, wrap};
 use crate::run::Bounds;
@@ -47,7 +47,7 @@ impl VesselTrack<'_> {
 }
 
 /// Median, 99th percentile and maximum (nearest-rank percentiles), ignoring NaN.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Stats {
     /// Median (nearest rank: the value at rank ceil(0.5 n)).
     pub median: f64,
@@ -84,7 +84,7 @@ pub fn stats(values: &[f64]) -> Option<Stats> {
 }
 
 /// Tolerances of the paper's settling time (section 4.2.3).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SettleCriteria {
     /// Distance to the destination, m: half the ship length.
     pub position_m: f64,
@@ -303,7 +303,7 @@ pub fn min_with_time(t: &[f64], d: &[f64]) -> Option<(f64, f64)> {
 }
 
 /// One hull-overlap event: a maximal run of consecutive overlapping samples of one pair.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CollisionEvent {
     /// First body (`ship`, `tug1`, `tug2`).
     pub a: String,
@@ -397,7 +397,7 @@ impl OverlapTracker {
 }
 
 /// Violations of one bound.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 pub struct Violations {
     /// Samples (or sample pairs, for rates) outside the bound.
     pub count: usize,
@@ -440,7 +440,7 @@ impl Violations {
 }
 
 /// Commands outside the bounds of Du et al. (2022), Tables 2 and 3 (eq. (17)-(21)).
-#[derive(Debug, Clone, PartialEq, Serialize, Default)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 pub struct BoundReport {
     /// Commanded tension outside `[min, max]`, both lines (N).
     pub tension: Violations,

@@ -11,9 +11,9 @@ use std::sync::OnceLock;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::analysis::PlotData;
 use crate::error::{AnalyzerError, Result};
 use crate::geometry::{body_to_ned, circle, ellipse, hull_outline};
+use crate::plot_sink::PlotData;
 
 /// DejaVu Sans (Bitstream Vera license, `assets/DejaVuSans-LICENSE.txt`).
 static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
@@ -485,7 +485,7 @@ where
         .solver
         .as_ref()
         .map(|s| s.compute_time.clone())
-        .unwrap_or_else(|| crate::analysis::Histogram::new(&[], 40));
+        .unwrap_or_else(|| crate::plot_sink::Histogram::new(&[], 40));
     let hi = hist.hi;
     let width = hi / hist.counts.len().max(1) as f64;
     let counts = &hist.counts;

@@ -6,16 +6,19 @@ use std::path::{Path, PathBuf};
 
 use polars::prelude::*;
 
-use crate::analysis::{analyze_run, Metrics, VESSELS};
+use crate::analysis::{analyze_run, Metrics};
 use crate::colregs::EncounterReport;
-use crate::compare::{num, table6, table7, RunSummary};
+use crate::compare::{table6, table7, RunSummary};
 use crate::doc::{to_html, to_markdown, Block};
 use crate::error::{AnalyzerError, Result};
 use crate::frames::ControllerFrames;
 use crate::plots::{write_plots, PlotFile};
 use crate::progress;
+use crate::rows::VESSELS;
 use crate::run::load_run;
 use crate::stream::{StreamOptions, TableOut};
+use crate::thresholds::Thresholds;
+use crate::verdict::Reason;
 
 /// What `report` wrote.
 #[derive(Debug, Clone)]
@@ -26,15 +29,22 @@ pub struct ReportOutcome {
     pub written: Vec<PathBuf>,
 }
 
-/// Reads the logs, analyses the run and writes everything into `out`.
+/// Reads the logs, analyses the run (the verdict under the default thresholds) and writes
+/// everything into `out`.
 ///
 /// # Errors
 /// See [`crate::error::AnalyzerError`]: unusable inputs name the file and the problem.
 pub fn report(out: &Path, logs: &[PathBuf], quiet: bool) -> Result<ReportOutcome> {
-    report_with(out, logs, quiet, &StreamOptions::default())
+    report_with(
+        out,
+        logs,
+        quiet,
+        &StreamOptions::default(),
+        &Thresholds::default(),
+    )
 }
 
-/// [`report`] with the streaming analysis' sizes `opts`.
+/// [`report`] with the streaming analysis' sizes `opts` and the verdict's `thresholds`.
 ///
 /// # Errors
 /// As [`report`].
@@ -43,11 +53,12 @@ pub fn report_with(
     logs: &[PathBuf],
     quiet: bool,
     opts: &StreamOptions,
+    thresholds: &Thresholds,
 ) -> Result<ReportOutcome> {
     let multi = progress::multi(quiet);
     let run = load_run(logs, &multi)?;
     std::fs::create_dir_all(out).map_err(|e| AnalyzerError::write(out, e))?;
-    let analysis = analyze_run(run, Some(out), &multi, opts)?;
+    let analysis = analyze_run(run, Some(out), &multi, opts, thresholds)?;
 
     let stage = progress::stage(&multi, "tables");
     let mut written = Vec::new();
@@ -69,7 +80,7 @@ pub fn report_with(
     let md = out.join("report.md");
     std::fs::write(&md, to_markdown(&blocks)).map_err(|e| AnalyzerError::write(&md, e))?;
     let html = out.join("report.html");
-    let title = format!("Towing run report: {}", analysis.metrics.scenario);
+    let title = format!("Towing run report: {}", analysis.metrics.run.scenario);
     std::fs::write(&html, to_html(&title, &blocks)).map_err(|e| AnalyzerError::write(&html, e))?;
     written.push(md);
     written.push(html);
@@ -180,7 +191,7 @@ fn distance_frame(m: &Metrics) -> Result<DataFrame> {
     let mut length = Vec::new();
     let mut norm = Vec::new();
     let mut t = Vec::new();
-    for o in &m.normalized_min_distance {
+    for o in &m.distances.normalized_min_distance {
         for v in VESSELS {
             if let Some(d) = o.vessels.get(v) {
                 obstacle.push(o.obstacle.as_str());
@@ -244,142 +255,44 @@ fn write_tables(out: &Path, ctrl: &ControllerFrames, m: &Metrics) -> Result<Vec<
     w.extend(write_frame(
         out,
         "encounters",
-        &mut encounter_frame(&m.colregs)?,
+        &mut encounter_frame(&m.colregs.colregs)?,
     )?);
     w.extend(write_frame(out, "min_distances", &mut distance_frame(m)?)?);
     Ok(w)
 }
 
-fn pct(v: Option<f64>) -> String {
-    v.map_or_else(|| "-".to_owned(), |v| format!("{:.2} %", v * 100.0))
+/// The verdict as report blocks: passed, or every reason.
+fn verdict_blocks(m: &Metrics) -> Vec<Block> {
+    let v = &m.verdict;
+    let mut b = vec![Block::Heading(2, "Verdict".to_owned())];
+    if v.passed {
+        b.push(Block::Para("passed: no metric gave a reason".to_owned()));
+    } else {
+        b.push(Block::Para(format!("FAILED: {} reasons", v.reasons.len())));
+        b.push(Block::List(v.reasons.iter().map(Reason::line).collect()));
+    }
+    b
 }
 
+/// The report: every registered metric's part (head, summary rows, blocks after the
+/// summary, details; in registration order) around the verdict, the paper's tables, the
+/// plots and the files read.
 fn report_blocks(m: &Metrics, plots: &[PlotFile]) -> Result<Vec<Block>> {
-    let mut b = Vec::new();
-    b.push(Block::Heading(
-        1,
-        format!("Towing run: scenario {}", m.scenario),
-    ));
-    let arch = m.architecture.as_ref().map_or_else(
-        || "unknown (no controller log)".to_owned(),
-        |a| format!("{} ({})", a.name, a.code),
-    );
-    let scheme = m.scheme.as_ref().map_or_else(
-        || "unknown".to_owned(),
-        |s| format!("{} ({})", s.name, s.code),
-    );
-    if m.truncated {
-        for t in &m.truncated_files {
-            b.push(Block::Para(format!(
-                "WARNING: {} is truncated: {}. The report covers what was read ({:.1} s to {:.1} s).",
-                t.file, t.reason, m.start_s, m.end_s
-            )));
-        }
-    }
-    b.push(Block::List(vec![
-        format!("architecture: {arch}; avoidance scheme: {scheme}"),
-        format!("scenario: {} ({})", m.scenario, m.scenario_source),
-        format!(
-            "simulated {:.1} s to {:.1} s: {} plant steps, {} control samples",
-            m.start_s, m.end_s, m.plant_steps, m.control_samples
-        ),
-        format!(
-            "files: {}",
-            m.files
-                .iter()
-                .map(|f| format!("{} ({}, {} bytes)", f.path.display(), f.unit, f.bytes))
-                .collect::<Vec<_>>()
-                .join("; ")
-        ),
-    ]));
-    if !m.notes.is_empty() {
-        b.push(Block::List(
-            m.notes.iter().map(|n| format!("note: {n}")).collect(),
-        ));
-    }
-
+    let parts = m.report_parts();
+    let mut b: Vec<Block> = parts.iter().flat_map(|p| p.head.iter().cloned()).collect();
+    b.extend(verdict_blocks(m));
     b.push(Block::Heading(2, "Summary".to_owned()));
-    let stats = |s: &Option<crate::metrics::Stats>, prec: usize| {
-        s.map_or_else(
-            || "-".to_owned(),
-            |s| {
-                format!(
-                    "median {:.prec$}, p99 {:.prec$}, max {:.prec$} (n = {})",
-                    s.median, s.p99, s.max, s.count
-                )
-            },
-        )
-    };
-    let bv = &m.bound_violations.report;
     b.push(Block::Table {
         headers: vec!["metric".into(), "value".into(), "definition".into()],
-        rows: vec![
-            vec![
-                "settling time".into(),
-                m.settling_time_s
-                    .map_or_else(|| "never settled".to_owned(), |t| format!("{t:.1} s")),
-                "first time after which the ship stays within L/2 of the destination, 3 deg of its heading, |u|,|v| < 0.01 m/s, |r| < 0.01 rad/s (paper, section 4.2.3)".into(),
-            ],
-            vec![
-                "max towline elongation error".into(),
-                format!(
-                    "{} / {}",
-                    pct(m.max_towline_elongation_error[0]),
-                    pct(m.max_towline_elongation_error[1])
-                ),
-                "max |l - l_tow| / l_tow, towline 1 / 2".into(),
-            ],
-            vec![
-                "ship travel".into(),
-                format!("{:.2} m", m.ship_travel_m),
-                "length of the ship's track".into(),
-            ],
-            vec![
-                "collisions".into(),
-                m.collisions.to_string(),
-                "hull-overlap events: hull rectangles vs hazard circles, target ellipses and each other".into(),
-            ],
-            vec![
-                "bound violations".into(),
-                bv.total.to_string(),
-                "commands outside the tension, tension rate, towing angle, angle rate and thrust bounds".into(),
-            ],
-            vec![
-                "sample computation time".into(),
-                stats(&m.sample_time_ms, 2) + " ms",
-                "wall time per control sample (controller log)".into(),
-            ],
-            vec![
-                "ADMM iterations".into(),
-                stats(&m.admm_iterations, 0),
-                format!(
-                    "per control sample; converged in {}",
-                    m.admm_converged_fraction
-                        .map_or_else(|| "-".to_owned(), |f| format!("{:.1} % of samples", f * 100.0))
-                ),
-            ],
-            vec![
-                "fallbacks".into(),
-                m.fallbacks.to_string(),
-                "samples whose plan was replaced by the shifted previous plan".into(),
-            ],
-            vec![
-                "unit warnings / errors".into(),
-                format!("{} / {}", m.unit_warnings, m.unit_errors),
-                "/plant/log and /controller/log".into(),
-            ],
-        ],
+        rows: parts
+            .iter()
+            .flat_map(|p| p.summary.iter().map(|r| r.to_vec()))
+            .collect(),
     });
-    if let Some(f) = &m.final_state {
-        b.push(Block::Para(format!(
-            "At the end of the log ({:.1} s) the ship is {:.3} m from the destination, heading error {:.2} deg, speed {:.4} m/s.",
-            f.t_s, f.distance_to_destination_m, f.heading_error_deg, f.speed_m_s
-        )));
-    }
+    b.extend(parts.iter().flat_map(|p| p.after_summary.iter().cloned()));
 
     // The paper's tables for this run.
-    let value = serde_json::to_value(m).map_err(|e| AnalyzerError::frame("metrics", e))?;
-    let summary = RunSummary::from_json("this run", &value);
+    let summary = RunSummary::from_metrics("this run", m);
     b.push(Block::Heading(
         2,
         "Table 6 layout: normalised minimum distance (eq. (30)) and COLREGS compliance".to_owned(),
@@ -390,205 +303,7 @@ fn report_blocks(m: &Metrics, plots: &[PlotFile]) -> Result<Vec<Block>> {
         "Table 7 layout: avoidance and control performance".to_owned(),
     ));
     b.push(table7(std::slice::from_ref(&summary)));
-
-    b.push(Block::Heading(
-        2,
-        "Normalised minimum distance to every obstacle (eq. (30))".to_owned(),
-    ));
-    let mut rows = Vec::new();
-    for o in &m.normalized_min_distance {
-        let cell = |v: &str| {
-            o.vessels.get(v).map_or_else(
-                || "-".to_owned(),
-                |d| {
-                    format!(
-                        "{:.2} ({:.3} m at {:.0} s)",
-                        d.normalized, d.min_distance_m, d.t_s
-                    )
-                },
-            )
-        };
-        rows.push(vec![
-            o.obstacle.clone(),
-            o.kind.clone(),
-            o.encounter.clone(),
-            cell("ship"),
-            cell("tug1"),
-            cell("tug2"),
-        ]);
-    }
-    b.push(Block::Table {
-        headers: vec![
-            "obstacle".into(),
-            "kind".into(),
-            "encounter".into(),
-            "D ship".into(),
-            "D tug 1".into(),
-            "D tug 2".into(),
-        ],
-        rows,
-    });
-
-    b.push(Block::Heading(2, "COLREGS encounters".to_owned()));
-    if let Some(e) = m.colregs.first() {
-        let p = &e.params;
-        b.push(Block::Para(format!(
-            "Scoring after Woerner et al. (2018) at model scale (docs/analyzer.md): r_detect = {:.2} m ({:.2} L), r_min = {:.2} m ({:.2} L), r_nm = {:.2} m ({:.2} L), r_col = {:.2} m ({:.2} L) for the first target, L = {:.3} m the ship length; gamma_nm {}, gamma_col {}, w_r {}, w_theta {}, readily apparent course change {} deg. Side: sign of the target's bearing from the ship's bow at the CPA.",
-            p.r_detect_m, p.ranges_in_ship_lengths[0], p.r_min_m, p.ranges_in_ship_lengths[1],
-            p.r_nm_m, p.ranges_in_ship_lengths[2], p.r_col_m, p.ranges_in_ship_lengths[3],
-            p.ship_length_m, p.gamma_nm, p.gamma_col, p.w_r, p.w_theta, p.dchi_apparent_deg
-        )));
-    }
-    let rows = m
-        .colregs
-        .iter()
-        .map(|e| {
-            vec![
-                e.target.clone(),
-                format!(
-                    "{} / {}",
-                    e.situation.as_deref().unwrap_or("-"),
-                    e.role.as_deref().unwrap_or("-")
-                ),
-                e.situation_geometric.clone().unwrap_or_else(|| "-".into()),
-                num(e.t_detect_s, 1),
-                format!(
-                    "{} ({})",
-                    num(e.t_first_action_s, 1),
-                    e.first_action.as_deref().unwrap_or("none")
-                ),
-                num(e.course_change_deg, 1),
-                format!("{:.1}", e.t_cpa_s),
-                format!("{:.3} m ({:.2} L)", e.r_cpa_m, e.r_cpa_ship_lengths),
-                e.side.clone(),
-                e.passed.clone(),
-                if e.reasons.is_empty() || e.verdict == "compliant" {
-                    e.verdict.clone()
-                } else {
-                    format!("{}: {}", e.verdict, e.reasons.join("; "))
-                },
-                e.rule
-                    .map_or_else(|| "-".into(), |r| format!("Rule {r}: {}", num(e.score, 2))),
-            ]
-        })
-        .collect();
-    b.push(Block::Table {
-        headers: vec![
-            "target".into(),
-            "situation / role (controller)".into(),
-            "geometric".into(),
-            "detected (s)".into(),
-            "first action (s)".into(),
-            "course change (deg)".into(),
-            "CPA (s)".into(),
-            "range at CPA".into(),
-            "side".into(),
-            "passed".into(),
-            "verdict".into(),
-            "score".into(),
-        ],
-        rows,
-    });
-
-    b.push(Block::Heading(2, "Bounds".to_owned()));
-    let bd = &m.bound_violations.bounds;
-    let vrow = |name: &str, bound: String, v: &crate::metrics::Violations, unit: &str| {
-        vec![
-            name.to_owned(),
-            bound,
-            format!("{} of {}", v.count, v.checked),
-            if v.count > 0 {
-                format!("{:.4} {unit}", v.worst_excess)
-            } else {
-                "-".to_owned()
-            },
-            num(v.first_t_s, 1),
-        ]
-    };
-    b.push(Block::Table {
-        headers: vec![
-            "command".into(),
-            "bound".into(),
-            "violations".into(),
-            "worst excess".into(),
-            "first (s)".into(),
-        ],
-        rows: vec![
-            vrow(
-                "tension",
-                format!("{} .. {} N", bd.min_tension_n, bd.max_tension_n),
-                &bv.tension,
-                "N",
-            ),
-            vrow(
-                "tension rate",
-                format!("{} N/s", bd.tension_rate_n_per_s),
-                &bv.tension_rate,
-                "N/s",
-            ),
-            vrow(
-                "towing angle",
-                format!("{:.1} deg", bd.max_towing_angle_rad.to_degrees()),
-                &bv.towing_angle,
-                "deg",
-            ),
-            vrow(
-                "towing angle rate",
-                format!("{:.1} deg/s", bd.angle_rate_rad_per_s.to_degrees()),
-                &bv.towing_angle_rate,
-                "deg/s",
-            ),
-            vrow(
-                "tug thrust (commands)",
-                format!("{:?}", bd.max_thrust),
-                &bv.tug_thrust_command,
-                "N or N m",
-            ),
-            vrow(
-                "tug thrust (plant inputs)",
-                format!("{:?}", bd.max_thrust),
-                &bv.tug_thrust_input,
-                "N or N m",
-            ),
-        ],
-    });
-
-    if !m.collision_events.is_empty() {
-        b.push(Block::Heading(2, "Collisions (hull overlaps)".to_owned()));
-        b.push(Block::Table {
-            headers: vec![
-                "a".into(),
-                "b".into(),
-                "from (s)".into(),
-                "to (s)".into(),
-                "samples".into(),
-            ],
-            rows: m
-                .collision_events
-                .iter()
-                .map(|e| {
-                    vec![
-                        e.a.clone(),
-                        e.b.clone(),
-                        format!("{:.1}", e.t_start_s),
-                        format!("{:.1}", e.t_end_s),
-                        e.samples.to_string(),
-                    ]
-                })
-                .collect(),
-        });
-    }
-    if !m.fallback_reasons.is_empty() {
-        b.push(Block::Heading(2, "Fallbacks".to_owned()));
-        b.push(Block::Table {
-            headers: vec!["reason".into(), "samples".into()],
-            rows: m
-                .fallback_reasons
-                .iter()
-                .map(|(r, n)| vec![r.clone(), n.to_string()])
-                .collect(),
-        });
-    }
+    b.extend(parts.iter().flat_map(|p| p.details.iter().cloned()));
 
     b.push(Block::Heading(2, "Plots".to_owned()));
     for p in plots {
@@ -599,8 +314,13 @@ fn report_blocks(m: &Metrics, plots: &[PlotFile]) -> Result<Vec<Block>> {
             svg,
         });
     }
-
     b.push(Block::Heading(2, "Files".to_owned()));
+    b.push(files_table(m));
+    Ok(b)
+}
+
+/// What was read of each file, per topic.
+fn files_table(m: &Metrics) -> Block {
     let mut rows = Vec::new();
     for f in &m.files {
         for (topic, n) in &f.messages {
@@ -616,7 +336,7 @@ fn report_blocks(m: &Metrics, plots: &[PlotFile]) -> Result<Vec<Block>> {
             ]);
         }
     }
-    b.push(Block::Table {
+    Block::Table {
         headers: vec![
             "file".into(),
             "topic".into(),
@@ -624,8 +344,7 @@ fn report_blocks(m: &Metrics, plots: &[PlotFile]) -> Result<Vec<Block>> {
             "problems".into(),
         ],
         rows,
-    });
-    Ok(b)
+    }
 }
 
 #[cfg(test)]
@@ -635,6 +354,75 @@ mod tests {
 
     fn read_csv(path: &Path) -> String {
         std::fs::read_to_string(path).expect("csv")
+    }
+
+    /// A metric registered in `crate::metric::registry` (here the collisions metric, on
+    /// a synthetic run through a hazard) reaches `metrics.json` (its typed section, read
+    /// back by `analyzer compare`'s deserialiser), the report (its summary row and
+    /// detail table) and the verdict (a reason naming the metric, the target and the
+    /// time); the same run without the hazard passes.
+    #[test]
+    fn a_registered_metric_reaches_metrics_json_the_report_and_the_verdict() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let mut run = SynthRun::paper(1200);
+        run.scene = false;
+        run.speed = 0.1;
+        run.route = vec![[0.0, 0.0, 0.0], [15.0, 0.0, 0.0], [30.0, 0.0, 0.0]];
+        run.obstacles = vec![crate::synth::SynthObstacle {
+            name: "rock".to_owned(),
+            pos: [6.0, 0.0],
+            shape: crate::synth::SynthShape::Circle(1.0),
+            active_from: 0.0,
+        }];
+        let (plant, controller) = (dir.path().join("p.mcap"), dir.path().join("c.mcap"));
+        run.write(&plant, &controller).expect("logs");
+        let out = dir.path().join("hit");
+        let o = report(&out, &[plant, controller], true).expect("report");
+        let m = &o.metrics;
+        assert!(m.collisions.collisions > 0);
+
+        let text = std::fs::read_to_string(out.join("metrics.json")).expect("metrics.json");
+        let json: serde_json::Value = serde_json::from_str(&text).expect("json");
+        assert_eq!(json["collisions"], m.collisions.collisions);
+        assert_eq!(json["verdict"]["passed"], false);
+        assert_eq!(json["thresholds"]["drift_max_deg"], 30.0);
+        // Read back as the typed Metrics (serde_json's float parsing is the same either
+        // way, so the typed values written out again give the parsed file).
+        let back: Metrics = serde_json::from_str(&text).expect("typed metrics");
+        assert_eq!(serde_json::to_value(&back).expect("value"), json);
+        assert_eq!(back.verdict.reasons.len(), m.verdict.reasons.len());
+
+        assert!(!m.verdict.passed);
+        let r = m
+            .verdict
+            .reasons
+            .iter()
+            .find(|r| r.metric == "collisions")
+            .expect("a collisions reason");
+        assert_eq!(r.target.as_deref(), Some("rock"));
+        let first = m.collisions.collision_events[0].t_start_s;
+        assert_eq!(r.t_s, Some(first));
+
+        let md = std::fs::read_to_string(out.join("report.md")).expect("report.md");
+        assert!(md.contains("Collisions (hull overlaps)"), "detail table");
+        assert!(md.contains("| collisions | "), "summary row");
+        assert!(md.contains(&r.line()), "the reason in the verdict section");
+
+        run.obstacles.clear();
+        let (plant, controller) = (dir.path().join("p2.mcap"), dir.path().join("c2.mcap"));
+        run.write(&plant, &controller).expect("logs");
+        let clear = report(&dir.path().join("clear"), &[plant, controller], true).expect("report");
+        assert_eq!(clear.metrics.collisions.collisions, 0);
+        assert!(
+            !clear
+                .metrics
+                .verdict
+                .reasons
+                .iter()
+                .any(|r| r.metric == "collisions"),
+            "{:?}",
+            clear.metrics.verdict
+        );
     }
 
     /// The regression this guards: the plant log is analysed in batches with rows carried
@@ -657,14 +445,15 @@ mod tests {
             batch_steps: usize::MAX,
             ..StreamOptions::default()
         };
-        let w = report_with(&whole_dir, &logs, true, &whole).expect("one batch");
+        let w = report_with(&whole_dir, &logs, true, &whole, &Thresholds::default())
+            .expect("one batch");
         for batch_steps in [7, 97, 700] {
             let out = dir.path().join(format!("b{batch_steps}"));
             let opts = StreamOptions {
                 batch_steps,
                 ..StreamOptions::default()
             };
-            let b = report_with(&out, &logs, true, &opts).expect("batches");
+            let b = report_with(&out, &logs, true, &opts, &Thresholds::default()).expect("batches");
             assert_eq!(w.metrics, b.metrics, "batch {batch_steps}");
             for stem in ["timeseries", "obstacles", "controller"] {
                 let a = read_csv(&whole_dir.join(format!("{stem}.csv")));

@@ -9,7 +9,7 @@
 
 use std::path::{Path, PathBuf};
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use towing_log::topics::metadata_keys;
 use towing_model::Scenario;
 
@@ -17,12 +17,12 @@ use crate::error::{AnalyzerError, Result};
 use crate::read::{peek_log, read_into, ControllerData, LogFile, LogLine, Peek, Unit};
 
 /// What was read from one file.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FileSummary {
     /// The file.
     pub path: PathBuf,
     /// `plant`, `controller` or `plant and controller`.
-    pub unit: &'static str,
+    pub unit: String,
     /// File size, bytes.
     pub bytes: u64,
     /// Messages per topic.
@@ -39,7 +39,7 @@ pub struct FileSummary {
 
 /// Limits the commands are checked against (Du et al. 2022, Table 2 and 3; the
 /// controller's parameters when its log has them).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Bounds {
     /// Smallest tension, N.
     pub min_tension_n: f64,
@@ -69,7 +69,7 @@ impl Default for Bounds {
 }
 
 /// Sizes and settings taken from the scenario and the controller's parameters.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunConfig {
     /// Scenario name.
     pub scenario_name: String,
@@ -99,6 +99,25 @@ pub struct RunConfig {
     pub architecture: Option<i32>,
     /// Avoidance scheme code (1 I, 2 II, 3 III).
     pub scheme: Option<i32>,
+    /// Waterway half width, m: the controller parameter `waterway_half_width` when it is
+    /// nonzero, else the scenario's `[waterway] half_width` (`None`: neither). Not
+    /// written to `metrics.json` (its `config` predates the field); the metrics see it as
+    /// [`crate::step::RunGeometry::half_width`].
+    #[serde(skip)]
+    pub waterway_half_width: Option<f64>,
+}
+
+impl RunConfig {
+    /// What every metric knows of the run before the first step.
+    #[must_use]
+    pub fn geometry(&self) -> crate::step::RunGeometry {
+        crate::step::RunGeometry {
+            sizes: [self.ship_size, self.tug1_size, self.tug2_size],
+            route: self.route.clone(),
+            half_width: self.waterway_half_width,
+            detection_distance: self.detection_distance_m,
+        }
+    }
 }
 
 /// A run ready for analysis: the controller's data and the settings; the plant log is
@@ -344,7 +363,7 @@ fn load(
             plant_file = files.len();
             files.push(FileSummary {
                 path: paths[k].clone(),
-                unit: Unit::Plant.name(),
+                unit: Unit::Plant.name().to_owned(),
                 bytes: peeks[k].bytes,
                 messages: std::collections::BTreeMap::new(),
                 decode_errors: std::collections::BTreeMap::new(),
@@ -416,6 +435,9 @@ fn load(
         bounds,
         architecture,
         scheme,
+        waterway_half_width: param("waterway_half_width")
+            .filter(|w| *w > 0.0)
+            .or_else(|| scenario.waterway.as_ref().map(|w| w.half_width)),
     };
     for (path, reason) in empty {
         notes.push(format!(
@@ -424,7 +446,7 @@ fn load(
         ));
         files.push(FileSummary {
             path,
-            unit: "unknown (truncated)",
+            unit: "unknown (truncated)".to_owned(),
             bytes: 0,
             messages: std::collections::BTreeMap::new(),
             decode_errors: std::collections::BTreeMap::new(),
@@ -493,7 +515,7 @@ fn scenario_of(
 fn summarize(log: &LogFile) -> FileSummary {
     FileSummary {
         path: log.path.clone(),
-        unit: log.unit.name(),
+        unit: log.unit.name().to_owned(),
         bytes: log.bytes,
         messages: log.message_counts.clone(),
         decode_errors: log

@@ -4,7 +4,9 @@
 //! messages of a batch of plant steps (at most [`StreamOptions::batch_steps`] ship
 //! messages, ending at a change of log time), then builds the batch's frames
 //! ([`crate::frames::build_plant_batch`], as-of joins with the rows carried from the last
-//! batch), hands them to the [`PlantAccumulator`] (metrics and plot series) and appends
+//! batch), hands them to the metrics ([`Trackers`]: each batch column-wise, then its
+//! [`crate::step::PlantStep`]s in time order, [`StepBuilder`]) and to the [`PlotSink`],
+//! and appends
 //! the `timeseries` and `obstacles` tables to their CSV and Parquet files (polars' batched
 //! writers), and drops them. Memory is one batch, the controller's tables and the bounded
 //! plot series, whatever the length of the log.
@@ -17,10 +19,12 @@ use polars::io::csv::write::BatchedWriter as CsvBatched;
 use polars::io::parquet::write::BatchedWriter as ParquetBatched;
 use polars::prelude::*;
 
-use crate::analysis::PlantAccumulator;
 use crate::error::{AnalyzerError, Result};
 use crate::frames::{build_plant_batch, Carry, ControllerFrames};
+use crate::metric::{RunContext, Trackers};
+use crate::plot_sink::PlotSink;
 use crate::read::{Msg, PlantData, Sink};
+use crate::rows::StepBuilder;
 use crate::run::RunConfig;
 
 /// Sizes of the streaming analysis.
@@ -121,7 +125,10 @@ pub struct PlantStream<'a> {
     batches: usize,
     carry: Carry,
     tables: Option<[TableOut; 2]>,
-    acc: PlantAccumulator,
+    steps: usize,
+    builder: StepBuilder,
+    metrics: Trackers,
+    plot: PlotSink,
 }
 
 impl std::fmt::Debug for PlantStream<'_> {
@@ -130,7 +137,7 @@ impl std::fmt::Debug for PlantStream<'_> {
             .field("opts", &self.opts)
             .field("batches", &self.batches)
             .field("batch_steps", &self.batch_steps)
-            .field("steps", &self.acc.steps())
+            .field("steps", &self.steps)
             .field("tables", &self.tables.is_some())
             .finish_non_exhaustive()
     }
@@ -139,14 +146,21 @@ impl std::fmt::Debug for PlantStream<'_> {
 impl<'a> PlantStream<'a> {
     /// A stream for a run with `config` and the controller's frames `ctrl`, writing the
     /// `timeseries` and `obstacles` tables into `tables` when given.
-    #[must_use]
+    ///
+    /// # Errors
+    /// The controller's reference table lacks a column (unexpected).
     pub fn new(
         config: &RunConfig,
         ctrl: &'a ControllerFrames,
         tables: Option<&Path>,
         opts: &StreamOptions,
-    ) -> Self {
-        PlantStream {
+    ) -> Result<Self> {
+        let geometry = config.geometry();
+        let run = RunContext {
+            config,
+            geometry: &geometry,
+        };
+        Ok(PlantStream {
             opts: *opts,
             ctrl,
             batch: PlantData::default(),
@@ -160,8 +174,11 @@ impl<'a> PlantStream<'a> {
                     TableOut::new(d, "obstacles"),
                 ]
             }),
-            acc: PlantAccumulator::new(config, opts),
-        }
+            steps: 0,
+            builder: StepBuilder::new(ctrl)?,
+            metrics: Trackers::new(&run),
+            plot: PlotSink::new(config, opts.plot_points, opts.track_rows),
+        })
     }
 
     /// Batches processed so far.
@@ -170,17 +187,30 @@ impl<'a> PlantStream<'a> {
         self.batches
     }
 
-    /// The accumulator (metrics and plot series so far).
+    /// Plant steps handed to the metrics so far.
     #[must_use]
-    pub fn accumulator(&self) -> &PlantAccumulator {
-        &self.acc
+    pub fn steps(&self) -> usize {
+        self.steps
+    }
+
+    /// The plot series so far.
+    #[must_use]
+    pub fn plot(&self) -> &PlotSink {
+        &self.plot
     }
 
     fn flush(&mut self) -> Result<()> {
         let plant = std::mem::take(&mut self.batch);
         self.batch_steps = 0;
         let b = build_plant_batch(plant, &mut self.carry, self.ctrl)?;
-        self.acc.update(&b)?;
+        self.metrics.batch(&b)?;
+        self.plot.batch(&b)?;
+        let (metrics, plot, steps) = (&mut self.metrics, &mut self.plot, &mut self.steps);
+        self.builder.for_each(&b, self.ctrl, |s| {
+            *steps += 1;
+            metrics.step(s);
+            plot.step(s);
+        })?;
         if let Some([ts, ob]) = &mut self.tables {
             ts.write(&mut b.timeseries(self.ctrl)?)?;
             ob.write(&mut b.obstacles.clone())?;
@@ -189,12 +219,12 @@ impl<'a> PlantStream<'a> {
         Ok(())
     }
 
-    /// Processes the last batch and closes the tables: the accumulator and the files
-    /// written.
+    /// Processes the last batch and closes the tables: the metrics' and the plots' states
+    /// and the files written.
     ///
     /// # Errors
     /// A table cannot be written; a polars error (unexpected).
-    pub fn finish(mut self) -> Result<(PlantAccumulator, Vec<PathBuf>)> {
+    pub fn finish(mut self) -> Result<(Trackers, PlotSink, Vec<PathBuf>)> {
         if let Err(e) = self.flush() {
             self.abandon();
             return Err(e);
@@ -205,7 +235,7 @@ impl<'a> PlantStream<'a> {
                 written.extend(t.finish()?);
             }
         }
-        Ok((self.acc, written))
+        Ok((self.metrics, self.plot, written))
     }
 
     /// Drops the stream and removes the tables written so far.

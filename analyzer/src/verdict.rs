@@ -31,7 +31,12 @@ impl Reason {
 
     /// A reason about one target ship or hazard.
     #[must_use]
-    pub fn target(metric: &str, target: &str, t_s: Option<f64>, message: impl Into<String>) -> Self {
+    pub fn target(
+        metric: &str,
+        target: &str,
+        t_s: Option<f64>,
+        message: impl Into<String>,
+    ) -> Self {
         Reason {
             metric: metric.to_owned(),
             target: Some(target.to_owned()),

@@ -14,23 +14,27 @@ fn settling_elongation_and_travel_are_known() {
     let m = &analyze_run(&run, dir.path());
     let expected = run.expected_settling_time().expect("arrives");
     assert!((expected - 300.0).abs() < 1e-9);
-    let ts = m.settling_time_s.expect("settles");
+    let ts = m.settling.settling_time_s.expect("settles");
     assert!((ts - expected).abs() < 1e-6, "settling {ts} vs {expected}");
-    let e = m.max_towline_elongation_error;
+    let e = m.elongation.max_towline_elongation_error;
     assert!((e[0].expect("line 1") - 0.0579).abs() < 1e-9, "{e:?}");
     assert!((e[1].expect("line 2") - 0.0633).abs() < 1e-9, "{e:?}");
-    assert!((m.ship_travel_m - 30.0).abs() < 1e-6, "{}", m.ship_travel_m);
-    assert_eq!(m.collisions, 0);
-    assert!(!m.truncated);
+    assert!(
+        (m.travel.ship_travel_m - 30.0).abs() < 1e-6,
+        "{}",
+        m.travel.ship_travel_m
+    );
+    assert_eq!(m.collisions.collisions, 0);
+    assert!(!m.run.truncated);
     assert_eq!(
-        m.architecture.as_ref().map(|a| a.name.as_str()),
+        m.run.architecture.as_ref().map(|a| a.name.as_str()),
         Some("distributed")
     );
-    assert_eq!(m.scheme.as_ref().map(|s| s.name.as_str()), Some("I"));
+    assert_eq!(m.run.scheme.as_ref().map(|s| s.name.as_str()), Some("I"));
     // Control statistics of the synthetic solver: iterations 10 + (7 k mod 21).
-    let it = m.admm_iterations.expect("iterations");
+    let it = m.solver.admm_iterations.expect("iterations");
     assert_eq!(it.max, 30.0);
-    assert_eq!(m.control_samples, 351);
+    assert_eq!(m.run.control_samples, 351);
 }
 
 #[test]
@@ -38,9 +42,9 @@ fn never_settles_when_the_log_ends_early() {
     let dir = tempfile::tempdir().expect("tempdir");
     let run = straight(30.0, 0.1, 2000);
     let m = analyze_run(&run, dir.path());
-    assert!(m.settling_time_s.is_none());
+    assert!(m.settling.settling_time_s.is_none());
     // Travel is what was covered: 200 s at 0.1 m/s.
-    assert!((m.ship_travel_m - 20.0).abs() < 1e-6);
+    assert!((m.travel.ship_travel_m - 20.0).abs() < 1e-6);
 }
 
 #[test]
@@ -52,7 +56,7 @@ fn head_on_pass_at_a_known_distance_on_port() {
     let mut run = straight(60.0, 0.1, 4000);
     run.obstacles = vec![target("C", 40.0, -1.5, 180.0, 0.07)];
     let m = &analyze_run(&run, dir.path());
-    let enc = m.colregs.first().expect("one encounter");
+    let enc = m.colregs.colregs.first().expect("one encounter");
     assert_eq!(enc.target, "C");
     assert!((enc.r_cpa_m - 1.5).abs() < 2e-3, "{}", enc.r_cpa_m);
     assert!((enc.t_cpa_s - 40.0 / 0.17).abs() < 0.11, "{}", enc.t_cpa_s);
@@ -62,7 +66,7 @@ fn head_on_pass_at_a_known_distance_on_port() {
     assert_eq!(enc.verdict, "violation");
     assert_eq!(enc.reasons.len(), 1, "{:?}", enc.reasons);
     assert!(enc.reasons[0].contains("no give-way action"));
-    let d = &m.normalized_min_distance[0];
+    let d = &m.distances.normalized_min_distance[0];
     assert_eq!(d.obstacle, "C");
     assert_eq!(d.encounter, "head-on");
     let ship = &d.vessels["ship"];
@@ -75,7 +79,7 @@ fn head_on_pass_at_a_known_distance_on_port() {
     let dir2 = tempfile::tempdir().expect("tempdir");
     run.obstacles = vec![target("C", 40.0, 1.5, 180.0, 0.07)];
     let b = analyze_run(&run, dir2.path());
-    let enc = &b.colregs[0];
+    let enc = &b.colregs.colregs[0];
     assert_eq!(enc.side, "starboard");
     assert_eq!(enc.verdict, "violation");
     assert!(enc
@@ -91,9 +95,14 @@ fn a_hazard_on_the_track_is_a_collision_of_each_vessel() {
     run.obstacles = vec![hazard("a", 15.0, 0.0), hazard("far", 15.0, 5.0)];
     let m = &analyze_run(&run, dir.path());
     // Ship, tug 1 and tug 2 each drive through "a" once; "far" (4.5 m clear) never.
-    assert_eq!(m.collisions, 3, "{:?}", m.collision_events);
+    assert_eq!(
+        m.collisions.collisions, 3,
+        "{:?}",
+        m.collisions.collision_events
+    );
     for v in ["ship", "tug1", "tug2"] {
         let e = m
+            .collisions
             .collision_events
             .iter()
             .find(|e| e.a == v && e.b == "a")
@@ -104,8 +113,9 @@ fn a_hazard_on_the_track_is_a_collision_of_each_vessel() {
             assert!((dur - (0.6275 + 0.5) * 2.0 / 0.1).abs() < 0.25, "{dur}");
         }
     }
-    assert!(m.collision_events.iter().all(|e| e.b != "far"));
+    assert!(m.collisions.collision_events.iter().all(|e| e.b != "far"));
     let far = m
+        .distances
         .normalized_min_distance
         .iter()
         .find(|o| o.obstacle == "far")
@@ -120,7 +130,7 @@ fn a_tension_spike_violates_the_bound_and_the_rate() {
     let mut run = straight(30.0, 0.1, 1000);
     run.tension_spike_at_sample = Some(50);
     let m = analyze_run(&run, dir.path());
-    let b = &m.bound_violations.report;
+    let b = &m.bounds.bound_violations.report;
     // Both lines at 3.5 N at sample 50: 2 bound violations; rates into and out of it.
     assert_eq!(b.tension.count, 2, "{b:?}");
     assert!((b.tension.worst_excess - 0.5).abs() < 1e-9);

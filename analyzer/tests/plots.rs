@@ -107,9 +107,10 @@ fn a_run_without_controller_log_still_plots() {
     let (plant, _) = common::write_logs(&run, dir.path());
     let out = dir.path().join("r");
     let outcome = analyzer::report(&out, &[plant], true).expect("report");
-    assert!(outcome.metrics.architecture.is_none());
+    assert!(outcome.metrics.run.architecture.is_none());
     assert!(outcome
         .metrics
+        .run
         .notes
         .iter()
         .any(|n| n.contains("no controller log")));

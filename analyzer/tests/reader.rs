@@ -159,7 +159,7 @@ fn truncated_at_many_offsets_never_panics() {
                     let out = dir.path().join(format!("report-{off}"));
                     let r = analyzer::report(&out, &[cut.clone(), controller.clone()], true);
                     match r {
-                        Ok(o) => assert!(o.metrics.truncated, "offset {off}"),
+                        Ok(o) => assert!(o.metrics.run.truncated, "offset {off}"),
                         Err(e) => assert!(e.to_string().contains("cut.mcap"), "offset {off}: {e}"),
                     }
                 }
@@ -197,9 +197,9 @@ fn a_truncated_log_still_gives_a_report() {
     std::fs::write(&plant, &full[..full.len() * 2 / 3]).expect("cut");
     let out = dir.path().join("report");
     let outcome = analyzer::report(&out, &[plant, controller], true).expect("report");
-    assert!(outcome.metrics.truncated);
-    assert_eq!(outcome.metrics.truncated_files.len(), 1);
-    assert!(outcome.metrics.truncated_files[0]
+    assert!(outcome.metrics.run.truncated);
+    assert_eq!(outcome.metrics.run.truncated_files.len(), 1);
+    assert!(outcome.metrics.run.truncated_files[0]
         .file
         .ends_with("plant.mcap"));
     let json = std::fs::read_to_string(out.join("metrics.json")).expect("metrics");
@@ -312,9 +312,9 @@ fn a_controller_log_cut_before_its_first_message_is_left_out() {
     assert!(e.to_string().contains("controller.mcap"));
     let out = dir.path().join("r");
     let o = analyzer::report(&out, &[plant.clone(), controller.clone()], true).expect("report");
-    assert!(o.metrics.truncated);
-    assert!(o.metrics.architecture.is_none());
-    assert!(o.metrics.notes.iter().any(|n| n.contains("left out")));
+    assert!(o.metrics.run.truncated);
+    assert!(o.metrics.run.architecture.is_none());
+    assert!(o.metrics.run.notes.iter().any(|n| n.contains("left out")));
     // Alone it is nothing useful: an error naming it.
     let e = analyzer::report(&out, &[controller], true).expect_err("nothing");
     assert!(e.to_string().contains("controller.mcap"), "{e}");
@@ -383,10 +383,10 @@ fn a_merged_log_with_late_controller_topics_and_scenario_is_read_whole() {
     let out = dir.path().join("r");
     let o = analyzer::report(&out, &[path], true).expect("report");
     let m = &o.metrics;
-    assert_eq!(m.plant_steps, 300);
-    assert_eq!(m.control_samples, 29, "samples from k = 10 on");
-    assert_eq!(m.architecture.as_ref().map(|a| a.code), Some(2));
-    assert_eq!(m.scenario, "straight", "the late attachment is used");
+    assert_eq!(m.run.plant_steps, 300);
+    assert_eq!(m.run.control_samples, 29, "samples from k = 10 on");
+    assert_eq!(m.run.architecture.as_ref().map(|a| a.code), Some(2));
+    assert_eq!(m.run.scenario, "straight", "the late attachment is used");
     assert_eq!(m.files.len(), 1);
     assert_eq!(m.files[0].unit, "plant and controller");
     assert_eq!(m.files[0].messages["/plant/ship"], 300);

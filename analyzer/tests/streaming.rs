@@ -53,7 +53,7 @@ fn plot_series_stay_bounded_and_metrics_equal_the_whole_column_formulas() {
         let (m, (lines, rows)) = common::with_options(&run, dir.path(), &SMALL, |a| {
             (a.metrics.clone(), plot_sizes(&a.plot))
         });
-        assert_eq!(m.plant_steps, steps + 1);
+        assert_eq!(m.run.plant_steps, steps + 1);
         // Bounded: at most `plot_points` per line, the strided rows plus the last one.
         assert!(lines <= SMALL.plot_points, "{steps} steps: {lines} points");
         assert!(rows <= SMALL.track_rows + 1, "{steps} steps: {rows} rows");
@@ -81,12 +81,17 @@ fn plot_series_stay_bounded_and_metrics_equal_the_whole_column_formulas() {
             v: Cow::Borrowed(&p.ship.v),
             r: Cow::Borrowed(&p.ship.r),
         };
-        let settle = settling_time(&t, &ship, m.config.destination, m.settling_criteria);
-        assert_eq!(m.settling_time_s, settle);
+        let settle = settling_time(
+            &t,
+            &ship,
+            m.config.destination,
+            m.settling.settling_criteria,
+        );
+        assert_eq!(m.settling.settling_time_s, settle);
         // Arrives at 1057.5 s.
         assert_eq!(settle.is_some(), steps > 10_575);
         assert_eq!(
-            m.ship_travel_m.to_bits(),
+            m.travel.ship_travel_m.to_bits(),
             travel(&p.ship.x, &p.ship.y).to_bits()
         );
         for k in 0..2 {
@@ -97,11 +102,11 @@ fn plot_series_stay_bounded_and_metrics_equal_the_whole_column_formulas() {
                 m.config.towline_desired_length[k],
             )
             .expect("elongation");
-            assert_eq!(m.max_towline_elongation_error[k], Some(e.0));
-            assert_eq!(m.max_towline_elongation_error_t_s[k], Some(e.1));
+            assert_eq!(m.elongation.max_towline_elongation_error[k], Some(e.0));
+            assert_eq!(m.elongation.max_towline_elongation_error_t_s[k], Some(e.1));
         }
         let ob = &p.obstacles;
-        for o in &m.normalized_min_distance {
+        for o in &m.distances.normalized_min_distance {
             let rows: Vec<usize> = (0..ob.t_ns.len())
                 .filter(|&i| ob.slot[i] == o.slot)
                 .collect();
@@ -132,7 +137,7 @@ fn plot_series_stay_bounded_and_metrics_equal_the_whole_column_formulas() {
         ];
         let b = check_bounds(None, Some((&ti, thrust)), &m.config.bounds);
         assert_eq!(
-            m.bound_violations.report.tug_thrust_input,
+            m.bounds.bound_violations.report.tug_thrust_input,
             b.tug_thrust_input
         );
         assert_eq!(b.tug_thrust_input.checked, 6 * (steps + 1));

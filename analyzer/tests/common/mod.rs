@@ -30,7 +30,14 @@ pub fn with_options<R>(
     let (plant, controller) = write_logs(run, dir);
     let multi = analyzer::progress::multi(true);
     let loaded = analyzer::run::load_run(&[controller, plant], &multi).expect("run");
-    let a = analyzer::analysis::analyze_run(loaded, None, &multi, opts).expect("analysis");
+    let a = analyzer::analysis::analyze_run(
+        loaded,
+        None,
+        &multi,
+        opts,
+        &analyzer::thresholds::Thresholds::default(),
+    )
+    .expect("analysis");
     f(&a)
 }
 

@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+"""Checks that the analyzer's outputs did not change: for each run directory under
+BASELINE (default /work/baseline; each with logs/plant.mcap, logs/controller.mcap and the
+report files an older analyzer wrote), runs `analyzer report -q` into OUT/<run> and
+compares
+
+- encounters.csv: byte for byte;
+- metrics.json: equal as JSON after removing the wall-time fields (`sample_time_ms`) and
+  the keys an older metrics.json lacks (`verdict`, `thresholds`).
+
+Usage: tests/tools/compare_baseline.py [--baseline DIR] [--out DIR] [--analyzer BIN]
+Exit status 0 when every run matches, 1 otherwise (each difference is printed).
+"""
+
+import argparse
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+# Measured in wall time, not a property of the run.
+TIMING_KEYS = {"sample_time_ms"}
+# Keys added since the baseline.
+NEW_KEYS = {"verdict", "thresholds"}
+
+
+def strip(metrics):
+    return {k: v for k, v in metrics.items() if k not in TIMING_KEYS | NEW_KEYS}
+
+
+def diff(a, b, path="$"):
+    """Paths where two JSON values differ (first few)."""
+    if type(a) is not type(b):
+        return [f"{path}: {a!r} != {b!r}"]
+    if isinstance(a, dict):
+        out = []
+        for k in sorted(set(a) | set(b)):
+            if k not in a or k not in b:
+                out.append(f"{path}.{k}: only in {'after' if k in b else 'baseline'}")
+            else:
+                out += diff(a[k], b[k], f"{path}.{k}")
+        return out
+    if isinstance(a, list):
+        if len(a) != len(b):
+            return [f"{path}: length {len(a)} != {len(b)}"]
+        out = []
+        for i, (x, y) in enumerate(zip(a, b)):
+            out += diff(x, y, f"{path}[{i}]")
+        return out
+    return [] if a == b else [f"{path}: {a!r} != {b!r}"]
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--baseline", type=Path, default=Path("/work/baseline"))
+    p.add_argument("--out", type=Path, default=Path("/tmp/after"))
+    p.add_argument("--analyzer", type=Path, default=Path("target/release/analyzer"))
+    args = p.parse_args()
+    runs = sorted(d for d in args.baseline.iterdir() if (d / "logs" / "plant.mcap").is_file())
+    if not runs:
+        print(f"no runs under {args.baseline}", file=sys.stderr)
+        return 1
+    failed = 0
+    for run in runs:
+        out = args.out / run.name
+        cmd = [str(args.analyzer), "report", "-q", "--out", str(out),
+               str(run / "logs" / "plant.mcap"), str(run / "logs" / "controller.mcap")]
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+        problems = []
+        if (run / "encounters.csv").read_bytes() != (out / "encounters.csv").read_bytes():
+            problems.append("encounters.csv differs")
+        before = json.loads((run / "metrics.json").read_text())
+        after = json.loads((out / "metrics.json").read_text())
+        for k in NEW_KEYS:
+            if k not in after:
+                problems.append(f"metrics.json lacks the new key {k}")
+        problems += [f"metrics.json {d}" for d in diff(strip(before), strip(after))[:20]]
+        verdict = after.get("verdict", {})
+        status = "identical" if not problems else "DIFFERENT"
+        print(f"{run.name}: {status} (verdict passed={verdict.get('passed')}, "
+              f"{len(verdict.get('reasons', []))} reasons)")
+        for pr in problems:
+            print(f"  {pr}")
+        failed += bool(problems)
+    print(f"{len(runs) - failed} of {len(runs)} runs unchanged")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
