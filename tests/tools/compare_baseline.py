@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Checks that the analyzer's outputs did not change: for each run directory under
 BASELINE (default /work/baseline; each with logs/plant.mcap, logs/controller.mcap and the
-report files an older analyzer wrote), runs `analyzer report -q` into OUT/<run> and
-compares
+report files an older analyzer wrote, run from BASELINE with relative log paths), runs
+`analyzer report -q` the same way into OUT/<run> and compares
 
 - encounters.csv: byte for byte;
 - metrics.json: equal as JSON after removing the wall-time fields (`sample_time_ms`) and
@@ -63,9 +63,11 @@ def main():
     failed = 0
     for run in runs:
         out = args.out / run.name
-        cmd = [str(args.analyzer), "report", "-q", "--out", str(out),
-               str(run / "logs" / "plant.mcap"), str(run / "logs" / "controller.mcap")]
-        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+        # From the baseline folder with relative log paths, as the baseline was made:
+        # the paths are recorded in metrics.json (`files`, `scenario_source`).
+        cmd = [str(args.analyzer.resolve()), "report", "-q", "--out", str(out.resolve()),
+               f"{run.name}/logs/plant.mcap", f"{run.name}/logs/controller.mcap"]
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, cwd=args.baseline)
         problems = []
         if (run / "encounters.csv").read_bytes() != (out / "encounters.csv").read_bytes():
             problems.append("encounters.csv differs")
