@@ -33,6 +33,7 @@ import xml.etree.ElementTree as ET
 import zipfile
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import campaign_report  # noqa: E402
 import campaign_task  # noqa: E402
 import tow_geometry  # noqa: E402
 
@@ -406,8 +407,6 @@ def execute_all(todo, c, bundle, args, out, on_record):
 
 def run_campaign(args):
     """Plans, runs (or resumes) and reports the campaign; returns the records in plan order."""
-    import campaign_report
-
     c = load_campaign(args.campaign)
     out = pathlib.Path(args.out)
     for name, p in (("--plant", args.plant), ("--controller", args.controller), ("--analyzer", args.analyzer)):

@@ -16,10 +16,13 @@ import re
 
 import numpy as np
 
-# Measured times, not results: they differ between two runs of the same campaign (the
-# analyzer's `sample_time_ms`, the controller's computation time per sample, and the run's
-# `wall_time_s`). Left out of the plots; tests compare everything else.
-TIMING_FIELDS = ("sample_time_ms", "wall_time_s")
+# Measured, not results: they differ between two runs of the same campaign. The run's
+# `wall_time_s`; the analyzer's `sample_time_ms` (the controller's computation time per
+# sample) and the log files' sizes `files[].bytes` (the logs hold those times as text, and
+# the worker's paths). Left out of the plots; tests compare everything else.
+MEASURED_FIELDS = ("wall_time_s", "sample_time_ms", "bytes")
+# Top-level entries of metrics.json that describe the run rather than measure it (not plotted).
+DESCRIPTIVE = ("architecture", "scheme", "config", "start_s", "end_s", "plant_steps", "control_samples", "thresholds", "files")
 MAX_PLOTS = 16
 TOP_REASONS = 10
 
@@ -77,13 +80,15 @@ def write_parquet(path, records):
 
 def key_metrics(records):
     """Names of the metrics plotted: numeric scalars at the top level of metrics.json or
-    one level down (no per-target or per-vessel lists), not timing fields, not constant."""
+    one level down (no per-target or per-vessel lists), neither measured (MEASURED_FIELDS)
+    nor describing the run (DESCRIPTIVE), and not the same in every run."""
     values = collections.defaultdict(list)
+    skip = set(MEASURED_FIELDS) | set(DESCRIPTIVE)
     for r in records:
         for k, v in (r.get("metrics") or {}).items():
             items = v.items() if isinstance(v, dict) else [(None, v)]
             for sub, x in items:
-                if isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) and k not in TIMING_FIELDS:
+                if isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) and k not in skip:
                     values[k if sub is None else f"{k}.{sub}"].append(float(x))
     return [k for k, v in values.items() if len(set(v)) > 1][:MAX_PLOTS], values
 
@@ -245,6 +250,8 @@ def write_all(out, name, records, keep_logs):
     write_parquet(out / "runs.parquet", records)
     plots = plot_distributions(records)
     (out / "plots").mkdir(exist_ok=True)
+    for old in (out / "plots").glob("*.png"):  # an earlier report's
+        old.unlink()
     for i, (png, _) in enumerate(plots.values()):
         (out / "plots" / f"{i:02d}.png").write_bytes(png)
     md_text = markdown(name, records, plots, keep_logs)

@@ -120,12 +120,13 @@ def execute(spec, bundle, scenario_bytes):
                 cmd += ["--thresholds", str(run_dir / "thresholds.toml")]
             cmd += [str(run_dir / "logs" / "plant.mcap"), str(run_dir / "logs" / "controller.mcap")]
             reason = _run_child(cmd, run_dir, deadline, limit, "analyzer")
+        # The worker's own directories out of what comes back: the same run says the same on
+        # every worker (the loader names `paper.toml:61:14: ...`, the analyzer `logs/plant.mcap`).
+        local = lambda text: text.replace(f"{run_dir}/", "").replace(f"{base}/", "")  # noqa: E731
         if reason is None:
-            judge(result, json.loads((run_dir / "report" / "metrics.json").read_text()))
+            judge(result, json.loads(local((run_dir / "report" / "metrics.json").read_text())))
         else:
-            # The worker's own directories out of the message: the same run says the same on
-            # every worker (the loader names the scenario file, e.g. `paper.toml:61:14: ...`).
-            reason["message"] = reason["message"].replace(f"{run_dir}/", "").replace(f"{base}/", "")
+            reason["message"] = local(reason["message"])
             result["reasons"] = [reason]
         if spec["keep_logs"]:
             result["files"] = collect_files(run_dir)

@@ -25,9 +25,9 @@ HALF_WIDTH = "[waterway]\nhalf_width = 5.0\n"
 
 
 def strip_timing(value):
-    """`value` without the fields that are measured times (campaign_report.TIMING_FIELDS)."""
+    """`value` without the measured fields (campaign_report.MEASURED_FIELDS: times, log sizes)."""
     if isinstance(value, dict):
-        return {k: strip_timing(v) for k, v in value.items() if k not in campaign_report.TIMING_FIELDS}
+        return {k: strip_timing(v) for k, v in value.items() if k not in campaign_report.MEASURED_FIELDS}
     if isinstance(value, list):
         return [strip_timing(v) for v in value]
     return value
@@ -266,23 +266,18 @@ def test_run_ids_are_content_hashes(tmp_path):
     assert a not in others and len(others) == 4
 
 
-def test_random_scenarios_come_from_the_generator_into_the_output_folder(tmp_path, monkeypatch):
-    calls = []
-
-    def random_scenarios(out_dir, seed, count, **options):
-        # Stand-in of masters/encounters.py's interface: files random-<seed>-<i>.toml.
-        calls.append((out_dir, seed, count, options))
-        out_dir.mkdir(parents=True, exist_ok=True)
-        paths = []
-        for i in range(count):
-            p = out_dir / f"random-{seed}-{i:04d}.toml"
-            p.write_text(PAPER.read_text())
-            paths.append(p)
-        return paths
-
-    monkeypatch.setitem(sys.modules, "encounters", type(sys)("encounters"))
-    monkeypatch.setattr(sys.modules["encounters"], "random_scenarios", random_scenarios, raising=False)
-    c = campaign.load_campaign(write(tmp_path, "[random]\nseed = 7\ncount = 3\nhazards = true\n"))
-    files = campaign.scenario_files(c, tmp_path / "out")
-    assert calls == [(tmp_path / "out" / "scenarios" / "random", 7, 3, {"hazards": True})]
-    assert [p.name for p in files] == ["paper.toml", "random-7-0000.toml", "random-7-0001.toml", "random-7-0002.toml"]
+def test_random_scenarios_come_from_the_generator_into_the_output_folder(tmp_path):
+    c = campaign.load_campaign(write(tmp_path, "[random]\nseed = 7\ncount = 3\nhazards = 0.5\n[parameters]\narchitecture = [1, 2]\n"))
+    bundle = {"TowingPlant.fmu": b"p"}
+    runs = campaign.plan(c, tmp_path / "out", bundle)
+    assert [(r["scenario"], r["parameters"]["architecture"]) for r in runs] == [
+        (name, a) for name in ["paper.toml", *(f"scenarios/random/random-7-{i:04d}.toml" for i in range(3))] for a in (1, 2)]
+    written = {p.name: p.read_bytes() for p in (tmp_path / "out" / "scenarios" / "random").iterdir()}
+    assert len(written) == 3
+    # The same seed, count and options: the same files, hence the same run ids.
+    again = campaign.plan(c, tmp_path / "again", bundle)
+    assert [r["id"] for r in again] == [r["id"] for r in runs]
+    assert {p.name: p.read_bytes() for p in (tmp_path / "again" / "scenarios" / "random").iterdir()} == written
+    c["random"]["colour"] = "red"
+    with pytest.raises(campaign.CampaignError, match="colour"):
+        campaign.plan(c, tmp_path / "bad", bundle)
