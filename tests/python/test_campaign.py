@@ -149,10 +149,11 @@ def dask_cluster(tmp_path_factory):
                 p.wait()
 
 
-def test_the_same_campaign_on_a_dask_cluster_gives_identical_results(local, four_runs, dask_cluster):
+def test_the_same_campaign_on_a_dask_cluster_gives_identical_results(local, four_runs, dask_cluster, fmus, analyzer):
     address, worker_dirs = dask_cluster
     out = four_runs.parent / "cluster"
-    r = xtask_campaign(four_runs, out, "--scheduler", address)
+    r = master(four_runs, out, fmus, analyzer, "--scheduler", address)
+    assert r.returncode == 0, r.stderr[-3000:]
     assert f"cluster {address}" in r.stderr
     here = json.loads((local[0] / "summary.json").read_text())
     there = json.loads((out / "summary.json").read_text())
@@ -162,13 +163,14 @@ def test_the_same_campaign_on_a_dask_cluster_gives_identical_results(local, four
         assert list(d.rglob("towing-campaign-*/TowingPlant.fmu")), f"nothing written in {d}"
 
 
-def test_resume_skips_every_finished_run(local, four_runs):
+def test_resume_skips_every_finished_run(local, four_runs, fmus, analyzer):
     out, _ = local
     results = sorted((out / "runs").glob("*/result.json"))
     assert len(results) == 4
     before = {p: p.stat().st_mtime_ns for p in results}
     summary = (out / "summary.json").read_text()
-    r = xtask_campaign(four_runs, out, "--workers", 1, "--resume")
+    r = master(four_runs, out, fmus, analyzer, "--workers", 1, "--resume")
+    assert r.returncode == 0, r.stderr[-3000:]
     assert "4 runs (4 already finished, skipped)" in r.stderr
     assert {p: p.stat().st_mtime_ns for p in results} == before
     assert (out / "summary.json").read_text() == summary
