@@ -257,12 +257,12 @@ def run_id(bundle, scenario_bytes, parameters, stop, c):
 
 
 def display_name(path, c, out):
-    for base in (c["file"].parent, out.resolve()):
-        try:
-            return path.relative_to(base).as_posix()
-        except ValueError:
-            pass
-    return str(path)
+    """A scenario's name in the outputs: relative to DIR for the generated ones, else
+    relative to the campaign file's folder (`../scenarios/suites/imazu/imazu-01.toml`)."""
+    try:
+        return path.relative_to(out.resolve()).as_posix()
+    except ValueError:
+        return pathlib.Path(os.path.relpath(path, c["file"].parent)).as_posix()
 
 
 def plan(c, out, bundle):

@@ -176,7 +176,8 @@ def markdown(name, records, plots, keep_logs):
         if not r["passed"]:
             lines.append(f"- {r['scenario']}, {r['configuration']} (`{r['id'][:12]}`):")
             for x in r["reasons"]:
-                where = "".join(f", {k} {x[k]}" for k in ("target", "t_s") if x.get(k) is not None)
+                where = (f", target {x['target']}" if x.get("target") is not None else "") + \
+                    (f", t = {x['t_s']:.1f} s" if isinstance(x.get("t_s"), (int, float)) else "")
                 lines.append(f"  - {x.get('metric')}{where}: {_one_line(x.get('message', ''))}")
     lines += ["", "## Distributions of the key metrics", ""]
     lines += [f"![{m}](plots/{i:02d}.png)" for i, m in enumerate(plots)] or ["No metric varies across the runs."]
