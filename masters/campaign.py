@@ -176,7 +176,8 @@ def random_files(c, out):
 
 
 def fmu_parameters(fmu):
-    """{name: FMI type} of the FMU's parameters, from the modelDescription.xml inside it."""
+    """{name: (FMI type, min, max)} of the FMU's parameters, from the modelDescription.xml
+    inside it (min and max None when not given)."""
     try:
         with zipfile.ZipFile(fmu) as z:
             root = ET.fromstring(z.read("modelDescription.xml"))
@@ -185,8 +186,9 @@ def fmu_parameters(fmu):
     out = {}
     for v in root.iter("ScalarVariable"):
         if v.get("causality") == "parameter":
-            types = [child.tag for child in v if child.tag in FMI_TYPES]
-            out[v.get("name")] = types[0] if types else None
+            types = [child for child in v if child.tag in FMI_TYPES]
+            bound = lambda key: float(types[0].get(key)) if types and types[0].get(key) is not None else None  # noqa: E731
+            out[v.get("name")] = (types[0].tag if types else None, bound("min"), bound("max"))
     return out
 
 
@@ -195,7 +197,7 @@ def check_parameters(c, plant, controller):
     fmus = {"controller": fmu_parameters(controller), "plant": fmu_parameters(plant)}
     for name, values in c["parameters"].items():
         side, fmi = ("plant", name[len("plant."):]) if name.startswith("plant.") else ("controller", name)
-        kind = fmus[side].get(fmi, "missing")
+        kind, low, high = fmus[side].get(fmi, ("missing", None, None))
         if kind == "missing":
             raise CampaignError(f"{c['file']}: [parameters] {name}: the {side} FMU has no parameter '{fmi}' "
                                 f"(its parameters: {', '.join(sorted(fmus[side]))})")
@@ -209,6 +211,10 @@ def check_parameters(c, plant, controller):
         bad = [v for v in values if not ok(v)]
         if bad:
             raise CampaignError(f"{c['file']}: [parameters] {name}: {side} parameter '{fmi}' is {kind}, got {bad[0]!r}")
+        outside = [v for v in values if not isinstance(v, (bool, str)) and ((low is not None and v < low) or (high is not None and v > high))]
+        if outside:
+            raise CampaignError(f"{c['file']}: [parameters] {name}: {side} parameter '{fmi}' must be in [{'-inf' if low is None else f'{low:g}'}, {'inf' if high is None else f'{high:g}'}] "
+                                f"(its modelDescription), got {outside[0]!r}")
 
 
 def configurations(c):

@@ -238,6 +238,9 @@ def test_parameters_and_globs_are_checked_before_anything_runs(tmp_path, fmus):
     c = campaign.load_campaign(write(tmp_path, "[parameters]\narchitecture = [1.5]\n"))
     with pytest.raises(campaign.CampaignError, match="controller parameter 'architecture' is Integer, got 1.5"):
         campaign.check_parameters(c, fmus["TowingPlant"], fmus["TowingController"])
+    c = campaign.load_campaign(write(tmp_path, "[parameters]\narchitecture = [1, 3]\n"))
+    with pytest.raises(campaign.CampaignError, match=r"controller parameter 'architecture' must be in \[1, 2\] .*, got 3"):
+        campaign.check_parameters(c, fmus["TowingPlant"], fmus["TowingController"])
     c = campaign.load_campaign(write(tmp_path, "[parameters]\n\"plant.hull_model\" = [1, 2]\narchitecture = [1, 2]\n"))
     campaign.check_parameters(c, fmus["TowingPlant"], fmus["TowingController"])
     assert campaign.configurations(c) == [{"plant.hull_model": 1, "architecture": 1}, {"plant.hull_model": 1, "architecture": 2},
