@@ -26,7 +26,9 @@ import logging
 import math
 import os
 import pathlib
+import subprocess
 import sys
+import tempfile
 import time
 import tomllib
 import xml.etree.ElementTree as ET
@@ -215,6 +217,22 @@ def check_parameters(c, plant, controller):
         if outside:
             raise CampaignError(f"{c['file']}: [parameters] {name}: {side} parameter '{fmi}' must be in [{'-inf' if low is None else f'{low:g}'}, {'inf' if high is None else f'{high:g}'}] "
                                 f"(its modelDescription), got {outside[0]!r}")
+
+
+def check_thresholds(c, analyzer):
+    """The [thresholds] table against the analyzer's own thresholds, before anything runs:
+    the analyzer reads the thresholds file before the logs, so a run on two missing logs
+    fails on the thresholds when they are bad (naming the key), else on the logs."""
+    if c["thresholds"] is None:
+        return
+    with tempfile.TemporaryDirectory(prefix="campaign-thresholds-") as d:
+        path = pathlib.Path(d) / "thresholds.toml"
+        path.write_text(campaign_task.thresholds_toml(c["thresholds"]))
+        r = subprocess.run([str(analyzer), "report", "-q", "--thresholds", str(path), "--out", str(pathlib.Path(d) / "out"),
+                            str(pathlib.Path(d) / "none-plant.mcap"), str(pathlib.Path(d) / "none-controller.mcap")],
+                           capture_output=True, text=True, timeout=60)
+    if f"thresholds {path}" in r.stderr:
+        raise CampaignError(f"{c['file']}: [thresholds]: {r.stderr.strip().replace(str(path), 'the table')}")
 
 
 def configurations(c):
@@ -419,6 +437,7 @@ def run_campaign(args):
         if not pathlib.Path(p).is_file():
             raise CampaignError(f"{name}: {p} is not a file")
     check_parameters(c, args.plant, args.controller)
+    check_thresholds(c, args.analyzer)
     out.mkdir(parents=True, exist_ok=True)
     bundle = bundle_for(args.plant, args.controller, args.analyzer)
     runs = plan(c, out, bundle)

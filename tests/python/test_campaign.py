@@ -251,6 +251,13 @@ def test_parameters_and_globs_are_checked_before_anything_runs(tmp_path, fmus):
         campaign.scenario_files(c, tmp_path / "out")
 
 
+def test_thresholds_are_checked_by_the_analyzer_before_anything_runs(tmp_path, analyzer):
+    c = campaign.load_campaign(write(tmp_path, "[thresholds]\ndrift_max = 45\n"))
+    with pytest.raises(campaign.CampaignError, match="unknown field `drift_max`"):
+        campaign.check_thresholds(c, analyzer)
+    campaign.check_thresholds(campaign.load_campaign(write(tmp_path, "[thresholds]\ndrift_max_deg = 45\n")), analyzer)
+
+
 def test_the_arrival_stop_time_follows_the_route_and_the_thresholds(tmp_path):
     c = campaign.load_campaign(write(tmp_path, ""))
     # The paper's route: 63.45 m (scenarios/paper.toml) at 0.05 m/s, plus 300 s.
