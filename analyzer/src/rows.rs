@@ -334,3 +334,64 @@ pub fn slot_index<T>(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frames::{build_controller, build_plant_batch, Carry};
+    use crate::synth::{SynthObstacle, SynthRun, SynthShape};
+
+    /// Every plant step once, in time order, with the vessels of its row, the obstacles
+    /// active at it (slot order) and the controller's latest sample at or before it.
+    #[test]
+    fn steps_carry_the_vessels_the_active_obstacles_and_the_last_control_sample() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let mut run = SynthRun::paper(400);
+        run.scene = false;
+        run.obstacles = vec![
+            SynthObstacle {
+                name: "late".to_owned(),
+                pos: [20.0, 5.0],
+                shape: SynthShape::Ship(1.48, 0.48, 180.0, 0.1),
+                active_from: 20.0,
+            },
+            SynthObstacle {
+                name: "rock".to_owned(),
+                pos: [10.0, 3.0],
+                shape: SynthShape::Circle(1.0),
+                active_from: 0.0,
+            },
+        ];
+        let (plant, controller) = (dir.path().join("p.mcap"), dir.path().join("c.mcap"));
+        run.write(&plant, &controller).expect("logs");
+        let bar = indicatif::ProgressBar::hidden();
+        let p = crate::read::read_log(&plant, &bar).expect("plant");
+        let c = crate::read::read_log(&controller, &bar).expect("controller");
+        let ctrl = build_controller(c.controller, &run.route).expect("controller frames");
+        let control_t = seconds(&ctrl.reference).expect("t");
+        let b = build_plant_batch(p.plant, &mut Carry::default(), &ctrl).expect("batch");
+        let ship_x = col(&b.vessels, "ship_x").expect("x").into_owned();
+        let mut builder = StepBuilder::new(&ctrl).expect("builder");
+        let mut seen: Vec<(f64, f64, Vec<String>, Option<f64>)> = Vec::new();
+        builder
+            .for_each(&b, &ctrl, |s| {
+                let names = s.obstacles.iter().map(|o| o.name.clone()).collect();
+                seen.push((s.t, s.vessels[0].x, names, s.control.map(|c| c.t)));
+            })
+            .expect("steps");
+        assert_eq!(seen.len(), ship_x.len());
+        assert!(seen.windows(2).all(|w| w[0].0 < w[1].0), "time order");
+        for (i, (t, x, names, ct)) in seen.iter().enumerate() {
+            assert_eq!(x.to_bits(), ship_x[i].to_bits());
+            // Slot order: "late" is slot 1, "rock" slot 2; "late" from its activation on.
+            let expect: Vec<&str> = if *t >= 20.0 - 1e-9 {
+                vec!["late", "rock"]
+            } else {
+                vec!["rock"]
+            };
+            assert_eq!(names, &expect, "t = {t}");
+            let latest = control_t.iter().copied().rfind(|c| c <= t);
+            assert_eq!(*ct, latest, "t = {t}");
+        }
+    }
+}

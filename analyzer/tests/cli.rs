@@ -217,4 +217,60 @@ fn a_truncated_log_is_reported_and_marked() {
         serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).expect("read"))
             .expect("json");
     assert_eq!(m["truncated"], true);
+    // A truncated log fails the verdict, naming the file.
+    assert_eq!(m["verdict"]["passed"], false);
+    let r = &m["verdict"]["reasons"][0];
+    assert_eq!(r["metric"], "truncated");
+    assert!(
+        r["message"]
+            .as_str()
+            .is_some_and(|t| t.contains("plant.mcap")),
+        "{r}"
+    );
+}
+
+#[test]
+fn thresholds_file_is_recorded_and_a_bad_one_is_refused_by_name() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let run = common::straight(20.0, 0.1, 300);
+    let (plant, controller) = common::write_logs(&run, dir.path());
+    let file = dir.path().join("t.toml");
+    std::fs::write(&file, "drift_max_deg = 20.0\nstall_max_s = 60.0\n").expect("write");
+    let out = dir.path().join("r");
+    let o = analyzer()
+        .args(["report", "-q", "--thresholds"])
+        .arg(&file)
+        .arg("--out")
+        .arg(&out)
+        .arg(&plant)
+        .arg(&controller)
+        .output()
+        .expect("run");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("verdict: passed"));
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).expect("read"))
+            .expect("json");
+    assert_eq!(m["thresholds"]["drift_max_deg"], 20.0);
+    assert_eq!(m["thresholds"]["stall_max_s"], 60.0);
+    assert_eq!(
+        m["thresholds"]["cross_ahead_min_m"], 7.0,
+        "the rest are defaults"
+    );
+    assert_eq!(m["verdict"]["passed"], true);
+    assert_eq!(m["verdict"]["reasons"].as_array().map(Vec::len), Some(0));
+
+    std::fs::write(&file, "drift_max = 20.0\n").expect("write");
+    let o = analyzer()
+        .args(["report", "-q", "--thresholds"])
+        .arg(&file)
+        .arg("--out")
+        .arg(dir.path().join("bad"))
+        .arg(&plant)
+        .output()
+        .expect("run");
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("t.toml") && err.contains("drift_max"), "{err}");
+    assert!(err.starts_with("analyzer report: thresholds "), "{err}");
 }

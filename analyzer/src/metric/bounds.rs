@@ -219,3 +219,49 @@ impl Metric for BoundChecks {
         r
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_violated_bound_is_one_reason_at_its_first_violation() {
+        let report = BoundReport {
+            tension_rate: Violations {
+                count: 2,
+                checked: 10,
+                worst_excess: 0.05,
+                first_t_s: Some(40.0),
+            },
+            towing_angle: Violations {
+                count: 1,
+                checked: 10,
+                worst_excess: 1.0,
+                first_t_s: Some(12.0),
+            },
+            ..BoundReport::default()
+        };
+        let m = BoundsSection {
+            bound_violations: BoundSection {
+                bounds: Bounds::default(),
+                report,
+            },
+        };
+        let r = BoundChecks::reasons(&m, &Thresholds::default());
+        assert_eq!(r.len(), 2);
+        assert_eq!(r[0].t_s, Some(12.0), "by time");
+        assert!(
+            r[0].message.starts_with("towing angle: 1 of 10"),
+            "{}",
+            r[0].message
+        );
+        assert!(r.iter().all(|r| r.metric == "bound_violations"));
+        let clean = BoundsSection {
+            bound_violations: BoundSection {
+                bounds: Bounds::default(),
+                report: BoundReport::default(),
+            },
+        };
+        assert!(BoundChecks::reasons(&clean, &Thresholds::default()).is_empty());
+    }
+}

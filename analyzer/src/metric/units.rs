@@ -58,3 +58,26 @@ impl Metric for UnitLogs {
         )]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unit_errors_fail_and_warnings_do_not() {
+        let th = Thresholds::default();
+        let warn = UnitLogSection {
+            unit_warnings: 3,
+            unit_errors: 0,
+        };
+        assert!(UnitLogs::reasons(&warn, &th).is_empty());
+        let err = UnitLogSection {
+            unit_warnings: 0,
+            unit_errors: 2,
+        };
+        let r = UnitLogs::reasons(&err, &th);
+        assert_eq!(r.len(), 1);
+        assert_eq!(r[0].metric, "unit_errors");
+        assert!(r[0].message.contains("2 errors"));
+    }
+}
