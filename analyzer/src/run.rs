@@ -387,8 +387,57 @@ fn load(
         }
     }
 
+    let config = run_config(&scenario, scenario_source, params.as_ref(), &controller);
+    for (path, reason) in empty {
+        notes.push(format!(
+            "{} is truncated before any usable message and was left out",
+            path.display()
+        ));
+        files.push(FileSummary {
+            path,
+            unit: "unknown (truncated)".to_owned(),
+            bytes: 0,
+            messages: std::collections::BTreeMap::new(),
+            decode_errors: std::collections::BTreeMap::new(),
+            schema_mismatches: Vec::new(),
+            truncated: Some(reason),
+            metadata: std::collections::BTreeMap::new(),
+        });
+    }
+    Ok(Run {
+        files,
+        plant_path: paths[plant].clone(),
+        plant_file,
+        controller,
+        logs: unit_logs,
+        config,
+        notes,
+        paths: paths.to_vec(),
+        plant_read_whole,
+        plant_scenario,
+        controller_path,
+    })
+}
+
+fn median_step_s(t_ns: &[i64]) -> Option<f64> {
+    let mut d: Vec<i64> = t_ns.windows(2).map(|w| w[1] - w[0]).collect();
+    if d.is_empty() {
+        return None;
+    }
+    d.sort_unstable();
+    Some(d[d.len() / 2] as f64 * 1e-9)
+}
+
+/// The run's sizes and settings: the scenario's, with the controller's parameters
+/// (`params`, the log's `parameters` metadata) and solver reports where they say more.
+fn run_config(
+    scenario: &Scenario,
+    scenario_source: String,
+    params: Option<&serde_json::Value>,
+    controller: &ControllerData,
+) -> RunConfig {
     let param = |name: &str| -> Option<f64> {
-        let v = params.as_ref()?.get(name)?;
+        let v = params?.get(name)?;
         v.as_f64().or_else(|| v.as_str()?.trim().parse().ok())
     };
     let defaults = Bounds::default();
@@ -439,44 +488,7 @@ fn load(
             .filter(|w| *w > 0.0)
             .or_else(|| scenario.waterway.as_ref().map(|w| w.half_width)),
     };
-    for (path, reason) in empty {
-        notes.push(format!(
-            "{} is truncated before any usable message and was left out",
-            path.display()
-        ));
-        files.push(FileSummary {
-            path,
-            unit: "unknown (truncated)".to_owned(),
-            bytes: 0,
-            messages: std::collections::BTreeMap::new(),
-            decode_errors: std::collections::BTreeMap::new(),
-            schema_mismatches: Vec::new(),
-            truncated: Some(reason),
-            metadata: std::collections::BTreeMap::new(),
-        });
-    }
-    Ok(Run {
-        files,
-        plant_path: paths[plant].clone(),
-        plant_file,
-        controller,
-        logs: unit_logs,
-        config,
-        notes,
-        paths: paths.to_vec(),
-        plant_read_whole,
-        plant_scenario,
-        controller_path,
-    })
-}
-
-fn median_step_s(t_ns: &[i64]) -> Option<f64> {
-    let mut d: Vec<i64> = t_ns.windows(2).map(|w| w[1] - w[0]).collect();
-    if d.is_empty() {
-        return None;
-    }
-    d.sort_unstable();
-    Some(d[d.len() / 2] as f64 * 1e-9)
+    config
 }
 
 /// The scenario attached to the plant log, else the controller's (`sources`: each log
