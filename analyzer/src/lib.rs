@@ -34,6 +34,7 @@ pub mod progress;
 pub mod read;
 pub mod report;
 pub mod run;
+pub mod seamanship;
 pub mod step;
 pub mod stream;
 pub mod synth;
