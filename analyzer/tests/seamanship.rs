@@ -465,3 +465,45 @@ fn seamanship_head_on_starboard_to_starboard_is_a_reason() {
     );
     assert!(metrics(&why).contains(&"rule16_action"), "{why:?}");
 }
+
+#[test]
+fn seamanship_overtaking_too_close_is_a_reason() {
+    // A slower target on the same course 0.5 m to starboard of the route: side by side,
+    // the gap between the hulls (half widths 0.15 m) and the ellipse (semi-minor axis
+    // 0.24 m) is 0.5 - 0.15 - 0.24 = 0.11 m.
+    let slow = Target {
+        name: "slow",
+        at_t0: [10.0, 0.5],
+        course_deg: 0.0,
+        speed: 0.03,
+    };
+    let r = run(800.0, cruise, no_offset, &[slow]);
+    let target = &r.rules.targets[0];
+    assert_eq!(target.situation.as_deref(), Some("overtaking"));
+    assert!(
+        close(target.min_hull_clearance_m.expect("detected"), 0.11, 1e-9),
+        "{target:?}"
+    );
+    let why = verdict(&r);
+    assert!(
+        why.iter()
+            .any(|r| r.metric == "rule13_overtaking" && r.message.contains("clearance")),
+        "{why:?}"
+    );
+    // Kept its course and speed: no give-way action either.
+    assert!(metrics(&why).contains(&"rule16_action"), "{why:?}");
+    // 1 m to starboard instead: 0.61 m, no clearance reason.
+    let wide = Target {
+        name: "wide",
+        at_t0: [10.0, 1.0],
+        course_deg: 0.0,
+        speed: 0.03,
+    };
+    let r = run(800.0, cruise, no_offset, &[wide]);
+    assert!(close(
+        r.rules.targets[0].min_hull_clearance_m.expect("detected"),
+        0.61,
+        1e-9
+    ));
+    assert!(!verdict(&r).iter().any(|r| r.message.contains("clearance")));
+}
