@@ -507,3 +507,35 @@ fn seamanship_overtaking_too_close_is_a_reason() {
     ));
     assert!(!verdict(&r).iter().any(|r| r.message.contains("clearance")));
 }
+
+#[test]
+fn seamanship_own_turn_is_not_the_target_crossing_ahead() {
+    // Head-on, the target 0.05 m to starboard of the route: the tow's 15 deg starboard
+    // turn puts it on the port side of the ship's heading line, but by the ship's motion,
+    // not the target's, so it is not past and clear until it is abaft the beam.
+    let turn = |t: f64, p: [f64; 2]| {
+        if t > 395.0 && t <= 500.0 {
+            (15.0, CRUISE, 0.0)
+        } else {
+            cruise(t, p)
+        }
+    };
+    let r = run(900.0, turn, no_offset, &[head_on(0.05)]);
+    let target = &r.rules.targets[0];
+    assert_eq!(target.situation.as_deref(), Some("head-on"));
+    assert_eq!(
+        target.past_and_clear.as_deref(),
+        Some("abaft the beam, opening"),
+        "{target:?}"
+    );
+    assert!(
+        target.t_past_and_clear_s.expect("past") > 450.0,
+        "{target:?}"
+    );
+    // Not given up; but the turn swings tug 2 (2 m ahead of the ship) across the target's
+    // course line ahead of it, within 7 m of it: that is a reason (Rule 14's crossing
+    // check), and the only one.
+    let why = verdict(&r);
+    assert_eq!(metrics(&why), ["rule14_head_on"], "{why:?}");
+    assert!(why[0].message.starts_with("tug2 crossed ahead"), "{why:?}");
+}
