@@ -1,0 +1,684 @@
+//! COLREGS rule checks per target ship, own ship being the towed ship (the tow's COLREGS
+//! identity, docs/colregs.md).
+//!
+//! Detection is the first step at which any vessel of the tow (ship, tugs) is within the
+//! detection distance `d_D` of the target (eq. (8): the guidance detects by the nearest
+//! vessel). The situation is classified there from the geometry
+//! ([`crate::colregs::classify`], Woerner preset); the controller's first definite
+//! situation for the slot (neither safe nor unclassified, `step.control`) is recorded too.
+//! The checks use the controller's when it has one, else the geometric one, and the report
+//! says which. Every check is measured for every target from its detection (O(1) state per
+//! target); the situation picks the ones that count at the verdict ([`reasons`]):
+//!
+//! - give-way (Rule 16; head-on, crossing give-way, overtaking): action before the CPA, a
+//!   course alteration of at least `give_way_turn_deg` to starboard from the heading at
+//!   detection or the way off (surge <= `way_off_surge_m_s`); held until the target is
+//!   past and clear (Rule 8(d)), else "given up" (`rule8_past_and_clear`);
+//! - no vessel of the tow crosses ahead of a give-way target closer than
+//!   `cross_ahead_min_m` (Rule 15: "avoid crossing ahead"; the same check for head-on and
+//!   overtaking under their rule);
+//! - head-on (Rule 14): a starboard alteration of at least `head_on_turn_deg` before the
+//!   CPA and a port-to-port pass (the target on the ship's port side at the CPA);
+//! - stand-on (Rule 17; crossing stand-on, being overtaken): until Rule 17(a)(ii) allows
+//!   action (TCPA <= `rule17_tcpa_s`), heading within `stand_on_course_deg` and speed over
+//!   ground at least `stand_on_speed_fraction` of their values at detection; Rule 17(c):
+//!   never a port turn of more than `port_turn_max_deg` while the target is on the port
+//!   side, until it is past and clear;
+//! - overtaking (Rule 13): hull clearance of every vessel of the tow from the target at
+//!   least `overtaking_clearance_m` ([`hull_ellipse_clearance`]).
+//!
+//! Past and clear (Rule 8(d)) is judged from the target's own motion relative to the tow,
+//! never from a range opened by the tow's braking: the target has crossed the ship's
+//! heading line ahead of the ship, moving across it (its side of the line changed between
+//! two steps, it was ahead of the ship, and its own velocity across the line points to the
+//! side it is now on, so the tow's own turn does not count), or it is abaft the ship's beam
+//! with the range opening while the tow makes way (surge > `way_off_surge_m_s`).
+
+use serde::{Deserialize, Serialize};
+
+use super::geometry::{
+    course_velocity, cpa_tcpa, hull_ellipse_clearance, line_coordinates, range_rate,
+};
+use super::VESSEL_NAMES;
+use crate::colregs::{classify, Situation};
+use crate::geometry::{dist, relative_bearing, wrap};
+use crate::step::{Obstacle, ObstacleKind, PlantStep, RunGeometry, Vessel};
+use crate::thresholds::Thresholds;
+use crate::verdict::Reason;
+
+/// Which situation the checks used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SituationSource {
+    /// The controller's first definite situation for the slot.
+    Controller,
+    /// The analyzer's classification at the tow's detection.
+    Geometric,
+}
+
+/// The tow's give-way action was released before the target was past and clear.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GiveUp {
+    /// Time of the release, s.
+    pub t_s: f64,
+    /// Range ship to target then, m.
+    pub range_m: f64,
+    /// Bearing of the target from the ship's bow then, deg (+ starboard).
+    pub bearing_deg: f64,
+}
+
+/// A vessel of the tow crossed the target's course line ahead of it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CrossAhead {
+    /// Time, s.
+    pub t_s: f64,
+    /// The vessel (`ship`, `tug1`, `tug2`).
+    pub vessel: String,
+    /// Its range to the target then, m.
+    pub range_m: f64,
+}
+
+/// The checks of one target ship.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TargetRules {
+    /// Target name (scenario).
+    pub target: String,
+    /// Obstacle slot, 1-based.
+    pub slot: u32,
+    /// The tow's detection (any vessel within `d_D`), s; `None`: never detected.
+    pub t_detect_s: Option<f64>,
+    /// Range ship to target at detection, m.
+    pub range_detect_m: Option<f64>,
+    /// The geometric situation at detection.
+    pub situation_geometric: Option<String>,
+    /// The controller's first definite situation for the slot.
+    pub situation_controller: Option<String>,
+    /// The role the controller reported with it (`give-way`, `stand-on`).
+    pub role_controller: Option<String>,
+    /// The situation the checks used.
+    pub situation: Option<String>,
+    /// Where it came from.
+    pub situation_source: Option<SituationSource>,
+    /// Time of the CPA (least ship-target centre range from detection on), s.
+    pub t_cpa_s: Option<f64>,
+    /// Range at the CPA, m.
+    pub r_cpa_m: Option<f64>,
+    /// Bearing of the target from the ship's bow at the CPA, deg (+ starboard).
+    pub beta_cpa_deg: Option<f64>,
+    /// Largest heading change to starboard from detection up to the CPA, deg.
+    pub starboard_turn_to_cpa_deg: Option<f64>,
+    /// First give-way action (starboard alteration or way off), s.
+    pub t_action_s: Option<f64>,
+    /// What it was (`starboard alteration`, `way off`).
+    pub action: Option<String>,
+    /// When the target became past and clear, s.
+    pub t_past_and_clear_s: Option<f64>,
+    /// How (`crossed ahead`, `abaft the beam, opening`).
+    pub past_and_clear: Option<String>,
+    /// The first release of the action before the target was past and clear.
+    pub given_up: Option<GiveUp>,
+    /// The first crossing ahead of the target closer than `cross_ahead_min_m`.
+    pub crossed_ahead: Option<CrossAhead>,
+    /// When Rule 17 allowed the stand-on vessel to act (TCPA <= `rule17_tcpa_s`), s.
+    pub t_rule17_s: Option<f64>,
+    /// Largest heading change before then, deg.
+    pub stand_on_course_change_deg: Option<f64>,
+    /// Least speed over ground before then, as a fraction of its value at detection.
+    pub stand_on_speed_fraction: Option<f64>,
+    /// First time the stand-on course or speed bound was broken before then, s.
+    pub t_stand_on_broken_s: Option<f64>,
+    /// Largest port turn (from the heading at detection) while the target was on the port
+    /// side, before it was past and clear, deg.
+    pub port_turn_port_target_deg: Option<f64>,
+    /// Its time, s.
+    pub t_port_turn_s: Option<f64>,
+    /// Least hull clearance of any vessel of the tow from the target after detection, m.
+    pub min_hull_clearance_m: Option<f64>,
+    /// Its time, s.
+    pub t_min_hull_clearance_s: Option<f64>,
+}
+
+/// The rule checks of every target ship, in order of first appearance.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct RulesReport {
+    /// One entry per target ship.
+    pub targets: Vec<TargetRules>,
+}
+
+/// The state at the tow's detection.
+#[derive(Debug, Clone, Copy)]
+struct Detection {
+    psi: f64,
+    sog: f64,
+    geometric: Situation,
+}
+
+/// The state of one target's checks.
+#[derive(Debug, Clone)]
+struct Target {
+    r: TargetRules,
+    present: bool,
+    det: Option<Detection>,
+    controller: Option<Situation>,
+    stbd_max: f64,
+    acting: bool,
+    /// The target's last side (non-zero) of the ship's heading line.
+    prev_side: Option<f64>,
+    /// Each vessel's last side (non-zero) of the target's course line.
+    prev_cross: [Option<f64>; 3],
+}
+
+/// Own vessels with the sizes, as the checks need them.
+type Tow<'s> = (&'s [Vessel; 3], &'s [[f64; 2]; 3]);
+
+impl Target {
+    fn new(o: &Obstacle) -> Self {
+        Target {
+            r: TargetRules {
+                target: o.name.clone(),
+                slot: o.slot,
+                t_detect_s: None,
+                range_detect_m: None,
+                situation_geometric: None,
+                situation_controller: None,
+                role_controller: None,
+                situation: None,
+                situation_source: None,
+                t_cpa_s: None,
+                r_cpa_m: None,
+                beta_cpa_deg: None,
+                starboard_turn_to_cpa_deg: None,
+                t_action_s: None,
+                action: None,
+                t_past_and_clear_s: None,
+                past_and_clear: None,
+                given_up: None,
+                crossed_ahead: None,
+                t_rule17_s: None,
+                stand_on_course_change_deg: None,
+                stand_on_speed_fraction: None,
+                t_stand_on_broken_s: None,
+                port_turn_port_target_deg: None,
+                t_port_turn_s: None,
+                min_hull_clearance_m: None,
+                t_min_hull_clearance_s: None,
+            },
+            present: false,
+            det: None,
+            controller: None,
+            stbd_max: 0.0,
+            acting: false,
+            prev_side: None,
+            prev_cross: [None; 3],
+        }
+    }
+
+    /// The situation known at this step: the controller's if it has given one, else the
+    /// geometric one at detection.
+    fn situation(&self) -> Option<Situation> {
+        self.controller.or(self.det.map(|d| d.geometric))
+    }
+
+    fn open_give_way(&self) -> bool {
+        self.present
+            && self.det.is_some()
+            && self.r.t_past_and_clear_s.is_none()
+            && self.situation().is_some_and(is_give_way)
+    }
+
+    /// The controller's first definite situation for the slot.
+    fn watch_controller(&mut self, step: &PlantStep<'_>) {
+        if self.controller.is_some() {
+            return;
+        }
+        let Some(c) = step.control else { return };
+        for e in c.encounters.iter().filter(|e| e.slot == self.r.slot) {
+            if let Some(s) = e.situation {
+                if !matches!(s, Situation::Safe | Situation::Unclassified) {
+                    self.controller = Some(s);
+                    self.r.situation_controller = Some(s.name().to_owned());
+                    self.r.role_controller = match e.role_code {
+                        1 => Some("give-way".to_owned()),
+                        2 => Some("stand-on".to_owned()),
+                        _ => None,
+                    };
+                    return;
+                }
+            }
+        }
+    }
+
+    /// Detection at this step if any vessel of the tow is within `d_detect`.
+    fn detect(&mut self, t: f64, ship: &Vessel, vessels: &[Vessel; 3], o: &Obstacle, d: f64) {
+        let tp = [o.x, o.y];
+        if self.det.is_some() || !vessels.iter().any(|v| dist([v.x, v.y], tp) < d) {
+            return;
+        }
+        let sp = [ship.x, ship.y];
+        let beta = relative_bearing(sp, ship.psi, tp).to_degrees();
+        let alpha = relative_bearing(tp, o.course, sp).to_degrees();
+        let geometric = classify(beta, alpha, ship.sog(), o.speed);
+        self.det = Some(Detection {
+            psi: ship.psi,
+            sog: ship.sog(),
+            geometric,
+        });
+        self.r.t_detect_s = Some(t);
+        self.r.range_detect_m = Some(dist(sp, tp));
+        self.r.situation_geometric = Some(geometric.name().to_owned());
+        self.r.stand_on_course_change_deg = Some(0.0);
+        self.r.stand_on_speed_fraction = Some(1.0);
+    }
+
+    /// One step of the checks after detection.
+    fn observe(&mut self, t: f64, tow: Tow<'_>, o: &Obstacle, th: &Thresholds) {
+        let Some(det) = self.det else { return };
+        let ship = tow.0[0];
+        let (sp, tp) = ([ship.x, ship.y], [o.x, o.y]);
+        let v_target = course_velocity(o.course, o.speed);
+        let range = dist(sp, tp);
+        let beta = relative_bearing(sp, ship.psi, tp).to_degrees();
+        let turn = wrap(ship.psi - det.psi).to_degrees();
+        self.stbd_max = self.stbd_max.max(turn);
+        if self.r.r_cpa_m.is_none_or(|r| range < r) {
+            self.r.t_cpa_s = Some(t);
+            self.r.r_cpa_m = Some(range);
+            self.r.beta_cpa_deg = Some(beta);
+            self.r.starboard_turn_to_cpa_deg = Some(self.stbd_max);
+        }
+        self.past_and_clear(t, &ship, o, th);
+        self.give_way_action(t, &ship, range, beta, th);
+        self.cross_ahead(t, tow.0, o, th);
+        self.stand_on(t, &ship, v_target, o, (turn, beta), th);
+        self.clearance(t, tow, o);
+    }
+
+    /// Rule 8(d): latches past and clear (see the module's doc).
+    fn past_and_clear(&mut self, t: f64, ship: &Vessel, o: &Obstacle, th: &Thresholds) {
+        let (sp, tp) = ([ship.x, ship.y], [o.x, o.y]);
+        let (along, side) = line_coordinates(sp, ship.psi, tp);
+        let prev = self.prev_side;
+        if side != 0.0 {
+            self.prev_side = Some(side);
+        }
+        if self.r.t_past_and_clear_s.is_some() {
+            return;
+        }
+        // The target's own velocity across the ship's heading line (+ to starboard).
+        let across_speed = o.speed * (o.course - ship.psi).sin();
+        let crossed =
+            prev.is_some_and(|p| p * side < 0.0) && along > 0.0 && across_speed * side > 0.0;
+        let beta = relative_bearing(sp, ship.psi, tp);
+        let opening = range_rate(sp, ship.vel_n(), tp, course_velocity(o.course, o.speed)) > 0.0;
+        let abaft =
+            beta.abs() > std::f64::consts::FRAC_PI_2 && opening && ship.u > th.way_off_surge_m_s;
+        if crossed || abaft {
+            self.r.t_past_and_clear_s = Some(t);
+            self.r.past_and_clear = Some(
+                if crossed {
+                    "crossed ahead"
+                } else {
+                    "abaft the beam, opening"
+                }
+                .to_owned(),
+            );
+        }
+    }
+
+    /// Rule 16 and 8(d): the first action, and its release before past and clear.
+    fn give_way_action(&mut self, t: f64, ship: &Vessel, range: f64, beta: f64, th: &Thresholds) {
+        let Some(det) = self.det else { return };
+        let turned = wrap(ship.psi - det.psi).to_degrees() >= th.give_way_turn_deg;
+        let way_off = ship.u <= th.way_off_surge_m_s;
+        let acting = turned || way_off;
+        if acting && self.r.t_action_s.is_none() {
+            self.r.t_action_s = Some(t);
+            self.r.action = Some(
+                if turned {
+                    "starboard alteration"
+                } else {
+                    "way off"
+                }
+                .to_owned(),
+            );
+        }
+        let released = self.acting && !acting;
+        if released && self.r.t_past_and_clear_s.is_none() && self.r.given_up.is_none() {
+            self.r.given_up = Some(GiveUp {
+                t_s: t,
+                range_m: range,
+                bearing_deg: beta,
+            });
+        }
+        self.acting = acting;
+    }
+
+    /// Rule 15: a vessel of the tow crossing the target's course line ahead of it, close.
+    fn cross_ahead(&mut self, t: f64, vessels: &[Vessel; 3], o: &Obstacle, th: &Thresholds) {
+        let tp = [o.x, o.y];
+        for (k, v) in vessels.iter().enumerate() {
+            let (along, side) = line_coordinates(tp, o.course, [v.x, v.y]);
+            let prev = self.prev_cross[k];
+            if side != 0.0 {
+                self.prev_cross[k] = Some(side);
+            }
+            let changed = prev.is_some_and(|p| p * side < 0.0);
+            let range = dist([v.x, v.y], tp);
+            if changed
+                && along > 0.0
+                && range < th.cross_ahead_min_m
+                && self.r.crossed_ahead.is_none()
+            {
+                self.r.crossed_ahead = Some(CrossAhead {
+                    t_s: t,
+                    vessel: VESSEL_NAMES[k].to_owned(),
+                    range_m: range,
+                });
+            }
+        }
+    }
+
+    /// Rule 17: course and speed kept until action is allowed; no port turn for a target
+    /// on the port side until it is past and clear.
+    fn stand_on(
+        &mut self,
+        t: f64,
+        ship: &Vessel,
+        v_target: [f64; 2],
+        o: &Obstacle,
+        (turn, beta): (f64, f64),
+        th: &Thresholds,
+    ) {
+        let Some(det) = self.det else { return };
+        if self.r.t_rule17_s.is_none() {
+            let (tcpa, _) = cpa_tcpa([ship.x, ship.y], ship.vel_n(), [o.x, o.y], v_target);
+            if tcpa <= th.rule17_tcpa_s {
+                self.r.t_rule17_s = Some(t);
+            } else {
+                let fraction = if det.sog > 0.0 {
+                    ship.sog() / det.sog
+                } else {
+                    1.0
+                };
+                let course = self
+                    .r
+                    .stand_on_course_change_deg
+                    .unwrap_or(0.0)
+                    .max(turn.abs());
+                let speed = self.r.stand_on_speed_fraction.unwrap_or(1.0).min(fraction);
+                self.r.stand_on_course_change_deg = Some(course);
+                self.r.stand_on_speed_fraction = Some(speed);
+                let broken =
+                    turn.abs() > th.stand_on_course_deg || fraction < th.stand_on_speed_fraction;
+                if broken && self.r.t_stand_on_broken_s.is_none() {
+                    self.r.t_stand_on_broken_s = Some(t);
+                }
+            }
+        }
+        if beta < 0.0 && self.r.t_past_and_clear_s.is_none() {
+            let port = (-turn).max(0.0);
+            if self.r.port_turn_port_target_deg.is_none_or(|m| port > m) {
+                self.r.port_turn_port_target_deg = Some(port);
+                self.r.t_port_turn_s = Some(t);
+            }
+        }
+    }
+
+    /// Rule 13: the least hull clearance (the exact distance is skipped when a lower bound,
+    /// centre distance less both circumradii, cannot beat the minimum so far).
+    fn clearance(&mut self, t: f64, (vessels, sizes): Tow<'_>, o: &Obstacle) {
+        for (v, [l, w]) in vessels.iter().zip(sizes) {
+            let bound = dist([v.x, v.y], [o.x, o.y]) - (l / 2.0).hypot(w / 2.0) - o.length / 2.0;
+            if self.r.min_hull_clearance_m.is_some_and(|m| bound >= m) {
+                continue;
+            }
+            let c = hull_ellipse_clearance(
+                (v.x, v.y, v.psi, *l, *w),
+                (o.x, o.y, o.course, o.length, o.width),
+            );
+            if self.r.min_hull_clearance_m.is_none_or(|m| c < m) {
+                self.r.min_hull_clearance_m = Some(c);
+                self.r.t_min_hull_clearance_s = Some(t);
+            }
+        }
+    }
+}
+
+/// The situations in which the tow is the give-way vessel (Rules 13, 14, 15).
+#[must_use]
+pub fn is_give_way(s: Situation) -> bool {
+    matches!(
+        s,
+        Situation::HeadOn | Situation::CrossingGiveWay | Situation::Overtaking
+    )
+}
+
+/// The situations in which the tow is the stand-on vessel (Rules 13, 15, 17).
+#[must_use]
+pub fn is_stand_on(s: Situation) -> bool {
+    matches!(s, Situation::CrossingStandOn | Situation::BeingOvertaken)
+}
+
+/// The rules tracker: one bounded state per target ship.
+#[derive(Debug, Clone)]
+pub struct RulesTracker {
+    th: Thresholds,
+    sizes: [[f64; 2]; 3],
+    d_detect: f64,
+    targets: Vec<Target>,
+}
+
+impl RulesTracker {
+    /// A tracker.
+    #[must_use]
+    pub fn new(geometry: &RunGeometry, thresholds: &Thresholds) -> Self {
+        RulesTracker {
+            th: *thresholds,
+            sizes: geometry.sizes,
+            d_detect: geometry.detection_distance,
+            targets: Vec::new(),
+        }
+    }
+
+    /// The next step.
+    pub fn push(&mut self, step: &PlantStep<'_>) {
+        for t in &mut self.targets {
+            t.present = false;
+        }
+        let ship = step.vessels[0];
+        for o in step
+            .obstacles
+            .iter()
+            .filter(|o| o.kind == ObstacleKind::Ship)
+        {
+            let k = match self.targets.iter().position(|t| t.r.slot == o.slot) {
+                Some(k) => k,
+                None => {
+                    self.targets.push(Target::new(o));
+                    self.targets.len() - 1
+                }
+            };
+            let target = &mut self.targets[k];
+            target.present = true;
+            target.watch_controller(step);
+            target.detect(step.t, &ship, &step.vessels, o, self.d_detect);
+            target.observe(step.t, (&step.vessels, &self.sizes), o, &self.th);
+        }
+        // The controller may report a target's situation before it is among the active
+        // obstacles of a step only in a malformed log; such reports are not kept.
+    }
+
+    /// Whether, after the last step pushed, the tow is giving way to a target that is
+    /// present, detected and not yet past and clear (the situation known so far: the
+    /// controller's, else the geometric one). Progress excuses a stall while it is.
+    #[must_use]
+    pub fn give_way_open(&self) -> bool {
+        self.targets.iter().any(Target::open_give_way)
+    }
+
+    /// The report.
+    #[must_use]
+    pub fn finish(self) -> RulesReport {
+        RulesReport {
+            targets: self
+                .targets
+                .into_iter()
+                .map(|mut t| {
+                    let (s, source) = match (t.controller, t.det) {
+                        (Some(c), _) => (Some(c), Some(SituationSource::Controller)),
+                        (None, Some(d)) => (Some(d.geometric), Some(SituationSource::Geometric)),
+                        (None, None) => (None, None),
+                    };
+                    t.r.situation = s.map(|s| s.name().to_owned());
+                    t.r.situation_source = source;
+                    t.r
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The situation of a report entry, from its name.
+fn situation_of(r: &TargetRules) -> Option<Situation> {
+    let name = r.situation.as_deref()?;
+    (0..=6)
+        .filter_map(Situation::from_code)
+        .find(|s| s.name() == name)
+}
+
+/// The rule reasons of every target (see the module's doc for the checks).
+#[must_use]
+pub fn reasons(report: &RulesReport, thresholds: &Thresholds) -> Vec<Reason> {
+    let mut out = Vec::new();
+    for r in &report.targets {
+        let Some(s) = situation_of(r) else { continue };
+        if r.t_detect_s.is_none() {
+            continue;
+        }
+        if is_give_way(s) {
+            give_way_reasons(r, s, thresholds, &mut out);
+        }
+        if is_stand_on(s) {
+            stand_on_reasons(r, thresholds, &mut out);
+        }
+    }
+    out
+}
+
+/// The rule named for a give-way situation.
+fn give_way_rule(s: Situation) -> &'static str {
+    match s {
+        Situation::HeadOn => "rule14_head_on",
+        Situation::Overtaking => "rule13_overtaking",
+        _ => "rule15_give_way",
+    }
+}
+
+fn give_way_reasons(r: &TargetRules, s: Situation, th: &Thresholds, out: &mut Vec<Reason>) {
+    let name = r.target.as_str();
+    let acted = r.t_action_s.zip(r.t_cpa_s).is_some_and(|(a, c)| a <= c);
+    if !acted {
+        out.push(Reason::target(
+            "rule16_action",
+            name,
+            r.t_cpa_s,
+            format!(
+                "no give-way action ({} deg to starboard or surge <= {} m/s) before the CPA",
+                th.give_way_turn_deg, th.way_off_surge_m_s
+            ),
+        ));
+    }
+    if let Some(g) = r.given_up {
+        out.push(Reason::target(
+            "rule8_past_and_clear",
+            name,
+            Some(g.t_s),
+            format!(
+                "give-way action given up before the target was past and clear (range {:.2} m, \
+                 bearing {:.0} deg)",
+                g.range_m, g.bearing_deg
+            ),
+        ));
+    }
+    if let Some(c) = &r.crossed_ahead {
+        out.push(Reason::target(
+            give_way_rule(s),
+            name,
+            Some(c.t_s),
+            format!(
+                "{} crossed ahead of the target at {:.2} m (< {} m)",
+                c.vessel, c.range_m, th.cross_ahead_min_m
+            ),
+        ));
+    }
+    if s == Situation::HeadOn {
+        let turn = r.starboard_turn_to_cpa_deg.unwrap_or(0.0);
+        if turn < th.head_on_turn_deg {
+            out.push(Reason::target(
+                "rule14_head_on",
+                name,
+                r.t_cpa_s,
+                format!(
+                    "starboard alteration {turn:.1} deg before the CPA, less than {} deg",
+                    th.head_on_turn_deg
+                ),
+            ));
+        }
+        if r.beta_cpa_deg.is_some_and(|b| b >= 0.0) {
+            out.push(Reason::target(
+                "rule14_head_on",
+                name,
+                r.t_cpa_s,
+                "passed starboard to starboard (Rule 14: port to port)",
+            ));
+        }
+    }
+    if s == Situation::Overtaking {
+        if let Some(c) = r.min_hull_clearance_m {
+            if c < th.overtaking_clearance_m {
+                out.push(Reason::target(
+                    "rule13_overtaking",
+                    name,
+                    r.t_min_hull_clearance_s,
+                    format!(
+                        "hull clearance {c:.2} m, less than {} m",
+                        th.overtaking_clearance_m
+                    ),
+                ));
+            }
+        }
+    }
+}
+
+fn stand_on_reasons(r: &TargetRules, th: &Thresholds, out: &mut Vec<Reason>) {
+    let name = r.target.as_str();
+    if let Some(t) = r.t_stand_on_broken_s {
+        out.push(Reason::target(
+            "rule17_stand_on",
+            name,
+            Some(t),
+            format!(
+                "course or speed not kept before Rule 17 allowed action (course change up to \
+                 {:.1} deg, limit {}; speed down to {:.0} %, limit {:.0} %)",
+                r.stand_on_course_change_deg.unwrap_or(0.0),
+                th.stand_on_course_deg,
+                100.0 * r.stand_on_speed_fraction.unwrap_or(1.0),
+                100.0 * th.stand_on_speed_fraction
+            ),
+        ));
+    }
+    if let Some(p) = r.port_turn_port_target_deg {
+        if p > th.port_turn_max_deg {
+            out.push(Reason::target(
+                "rule17_stand_on",
+                name,
+                r.t_port_turn_s,
+                format!(
+                    "turned {p:.1} deg to port for a target on the port side (Rule 17(c), \
+                     limit {} deg)",
+                    th.port_turn_max_deg
+                ),
+            ));
+        }
+    }
+}

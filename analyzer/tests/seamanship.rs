@@ -1,0 +1,541 @@
+//! Known answers of the seamanship and rule verdicts on synthetic trajectories: a straight
+//! route North from (0, 0) to (50, 0), the ship at 0.065 m/s with the tugs 2 m ahead and
+//! behind on its heading, plant steps of 0.5 s, scripted departures from that.
+
+use analyzer::seamanship::{reasons, Seamanship, SeamanshipReport};
+use analyzer::step::{Obstacle, ObstacleKind, PlantStep, RunGeometry, Vessel};
+use analyzer::thresholds::Thresholds;
+use analyzer::verdict::Reason;
+
+const DT: f64 = 0.5;
+const CRUISE: f64 = 0.065;
+const HALF_WIDTH: f64 = 5.0;
+
+fn geometry() -> RunGeometry {
+    RunGeometry {
+        sizes: [[1.255, 0.3], [0.97, 0.3], [0.97, 0.3]],
+        route: vec![[0.0, 0.0, 0.0], [50.0, 0.0, 0.0]],
+        half_width: Some(HALF_WIDTH),
+        detection_distance: 7.0,
+    }
+}
+
+/// A target ship on a straight line: position at t = 0 (it may be far), course (deg),
+/// speed.
+struct Target {
+    name: &'static str,
+    at_t0: [f64; 2],
+    course_deg: f64,
+    speed: f64,
+}
+
+impl Target {
+    fn at(&self, slot: u32, t: f64) -> Obstacle {
+        let c = self.course_deg.to_radians();
+        Obstacle {
+            slot,
+            name: self.name.to_owned(),
+            kind: ObstacleKind::Ship,
+            x: self.at_t0[0] + self.speed * c.cos() * t,
+            y: self.at_t0[1] + self.speed * c.sin() * t,
+            course: c,
+            speed: self.speed,
+            length: 1.48,
+            width: 0.48,
+        }
+    }
+}
+
+/// A run: `motion(t, ship position)` gives the ship's heading (deg), surge and sway at the
+/// step ending at `t`; the position integrates the velocity over ground; `offset(t)` is
+/// added to the ship's position (a scripted excursion); the tugs sit 2 m behind and ahead
+/// on the heading.
+fn run(
+    t_end: f64,
+    motion: impl Fn(f64, [f64; 2]) -> (f64, f64, f64),
+    offset: impl Fn(f64) -> [f64; 2],
+    targets: &[Target],
+) -> SeamanshipReport {
+    let g = geometry();
+    let mut seamanship = Seamanship::new(&g, &Thresholds::default());
+    let mut pos = [0.0, 0.0];
+    let n = (t_end / DT).round() as usize;
+    for k in 0..=n {
+        let t = k as f64 * DT;
+        let (psi_deg, u, v) = motion(t, pos);
+        let mut ship = Vessel {
+            x: 0.0,
+            y: 0.0,
+            psi: psi_deg.to_radians(),
+            u,
+            v,
+            r: 0.0,
+        };
+        if k > 0 {
+            let vel = ship.vel_n();
+            pos = [pos[0] + vel[0] * DT, pos[1] + vel[1] * DT];
+        }
+        let off = offset(t);
+        ship.x = pos[0] + off[0];
+        ship.y = pos[1] + off[1];
+        let (s, c) = ship.psi.sin_cos();
+        let tug = |d: f64| Vessel {
+            x: ship.x + d * c,
+            y: ship.y + d * s,
+            ..ship
+        };
+        let obstacles: Vec<Obstacle> = targets
+            .iter()
+            .enumerate()
+            .map(|(i, tg)| tg.at(i as u32 + 1, t))
+            .collect();
+        seamanship.push(&PlantStep {
+            t,
+            vessels: [ship, tug(-2.0), tug(2.0)],
+            obstacles: &obstacles,
+            control: None,
+        });
+    }
+    seamanship.finish()
+}
+
+/// Straight along the route at cruise speed, stopping at the destination.
+fn cruise(_t: f64, p: [f64; 2]) -> (f64, f64, f64) {
+    (0.0, if p[0] < 50.0 { CRUISE } else { 0.0 }, 0.0)
+}
+
+fn no_offset(_t: f64) -> [f64; 2] {
+    [0.0, 0.0]
+}
+
+fn verdict(r: &SeamanshipReport) -> Vec<Reason> {
+    reasons(r, &Thresholds::default())
+}
+
+fn metrics(reasons: &[Reason]) -> Vec<&str> {
+    reasons.iter().map(|r| r.metric.as_str()).collect()
+}
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol
+}
+
+#[test]
+fn seamanship_clean_straight_run_has_no_reason() {
+    let r = run(800.0, cruise, no_offset, &[]);
+    assert!(verdict(&r).is_empty(), "{:?}", verdict(&r));
+    assert_eq!(r.progress.route_length_m, Some(50.0));
+    // Within 2 m of (50, 0) from x = 48 m: 48 / 0.065 = 738.46 s, the step at 738.5 s.
+    assert_eq!(r.progress.t_arrival_s, Some(738.5));
+    assert_eq!(r.progress.arrival_deadline_s, Some(50.0 / 0.05 + 300.0));
+    assert!(close(r.speed.cruise_m_s.expect("under way"), CRUISE, 1e-4));
+    assert!(close(r.speed.max_cruise_ratio.expect("ratio"), 1.0, 2e-3));
+    assert_eq!(r.drift.max_drift_deg, Some(0.0));
+    assert_eq!(r.astern.time_astern_s, 0.0);
+    // Beyond the route's ends the distance is to the end point: tug 1's stern corners at
+    // the start are 2 + 0.485 m behind the origin and 0.15 m off the route; tug 2's bow
+    // corners at the end as far beyond the destination, plus the ship's overshoot of at
+    // most one step (0.0325 m).
+    let far = 2.485f64.hypot(0.15) - HALF_WIDTH;
+    let max = r.waterway.max_excess_m.expect("route");
+    assert!(max >= far - 1e-9 && max <= far + 0.0325, "{:?}", r.waterway);
+    assert_eq!(r.waterway.time_outside_s, 0.0);
+    assert!(r.waterway.groundings.is_empty());
+    // Stalls only of the time to cover 0.5 m: 0.5 / 0.065 = 7.7 s, on 0.5 s steps.
+    let stall = r.progress.longest_stall.expect("a stall");
+    assert!(stall.duration_s <= 8.0, "{stall:?}");
+}
+
+#[test]
+fn seamanship_sideways_drift_45_deg() {
+    // v = u (to starboard, then to port, back onto the route) from 100 s to 150 s, at
+    // the same speed over ground.
+    let k = CRUISE / 2f64.sqrt();
+    let motion = |t: f64, p: [f64; 2]| {
+        if t > 100.0 && t <= 125.0 {
+            (0.0, k, k)
+        } else if t > 125.0 && t <= 150.0 {
+            (0.0, k, -k)
+        } else {
+            cruise(t, p)
+        }
+    };
+    let r = run(800.0, motion, no_offset, &[]);
+    assert!(close(r.drift.max_drift_deg.expect("under way"), 45.0, 1e-9));
+    assert_eq!(r.drift.t_max_s, Some(100.5));
+    assert!(
+        close(r.drift.time_above_s, 50.0, 1e-9),
+        "{}",
+        r.drift.time_above_s
+    );
+    let why = verdict(&r);
+    assert_eq!(metrics(&why), ["drift"], "{why:?}");
+    assert_eq!(why[0].t_s, Some(100.5));
+}
+
+#[test]
+fn seamanship_stall_of_200_s_is_a_reason() {
+    let stop = |t: f64, p: [f64; 2]| {
+        if t > 300.0 && t <= 500.0 {
+            (0.0, 0.0, 0.0)
+        } else {
+            cruise(t, p)
+        }
+    };
+    let r = run(1000.0, stop, no_offset, &[]);
+    let stall = r.progress.longest_stall.expect("a stall");
+    // 200 s stopped plus at most the time to cover 0.5 m at cruise around it.
+    assert!(
+        stall.duration_s >= 200.0 && stall.duration_s <= 200.0 + 0.5 / CRUISE + DT,
+        "{stall:?}"
+    );
+    assert_eq!(stall.giving_way_s, 0.0);
+    let why = verdict(&r);
+    assert_eq!(metrics(&why), ["progress"], "{why:?}");
+}
+
+/// A target from starboard crossing the route 4 m ahead of the stopped ship (at x = 23.5
+/// m) westward at 0.05 m/s, on the route line at 490 s.
+fn crossing_from_starboard() -> Target {
+    Target {
+        name: "crossing",
+        at_t0: [23.5, 0.05 * 490.0],
+        course_deg: 270.0,
+        speed: 0.05,
+    }
+}
+
+/// The tow stops at 300 s (x = 19.5 m) and resumes at `resume` s.
+fn stop_until(resume: f64) -> impl Fn(f64, [f64; 2]) -> (f64, f64, f64) {
+    move |t, p| {
+        if t > 300.0 && t <= resume {
+            (0.0, 0.0, 0.0)
+        } else {
+            cruise(t, p)
+        }
+    }
+}
+
+#[test]
+fn seamanship_stall_while_giving_way_is_excused_and_a_correct_give_way_passes() {
+    let r = run(
+        1000.0,
+        stop_until(500.0),
+        no_offset,
+        &[crossing_from_starboard()],
+    );
+    let stall = r.progress.longest_stall.expect("a stall");
+    assert!(stall.duration_s >= 200.0, "{stall:?}");
+    // Detection when tug 2 (x = 21.5) is within 7 m: y < sqrt(45) = 6.708 m, from 356 s;
+    // past and clear at 490.5 s (the first step West of the route; 490 s if rounding puts
+    // it West already): 269 steps open.
+    assert!(
+        stall.giving_way_s >= 134.0 && stall.giving_way_s <= 134.5,
+        "{stall:?}"
+    );
+    let target = &r.rules.targets[0];
+    assert_eq!(target.t_detect_s, Some(356.0));
+    assert_eq!(target.situation.as_deref(), Some("crossing give-way"));
+    assert_eq!(target.action.as_deref(), Some("way off"));
+    let t_clear = target.t_past_and_clear_s.expect("past and clear");
+    assert!(t_clear == 490.0 || t_clear == 490.5, "{t_clear}");
+    assert_eq!(target.past_and_clear.as_deref(), Some("crossed ahead"));
+    assert_eq!(target.given_up, None);
+    assert!(target.crossed_ahead.is_none());
+    let why = verdict(&r);
+    assert!(why.is_empty(), "{why:?}");
+}
+
+#[test]
+fn seamanship_give_way_given_up_before_the_target_is_past() {
+    // Resumes at 450 s with the target 2 m East of the route, on the starboard bow.
+    let r = run(
+        1000.0,
+        stop_until(450.0),
+        no_offset,
+        &[crossing_from_starboard()],
+    );
+    let target = &r.rules.targets[0];
+    let g = target.given_up.expect("given up");
+    assert_eq!(g.t_s, 450.5);
+    // Target at (23.5, 1.975), ship at (19.5 + 0.0325, 0).
+    assert!(
+        close(g.range_m, (4.0f64 - 0.0325).hypot(1.975), 1e-9),
+        "{g:?}"
+    );
+    assert!(g.bearing_deg > 0.0 && g.bearing_deg < 45.0, "{g:?}");
+    let why = verdict(&r);
+    let rule8: Vec<&Reason> = why
+        .iter()
+        .filter(|r| r.metric == "rule8_past_and_clear")
+        .collect();
+    assert_eq!(rule8.len(), 1, "{why:?}");
+    assert_eq!(rule8[0].target.as_deref(), Some("crossing"));
+    assert_eq!(rule8[0].t_s, Some(450.5));
+    // Tug 2 then crosses the target's course line ahead of it, at under 7 m.
+    assert!(metrics(&why).contains(&"rule15_give_way"), "{why:?}");
+}
+
+#[test]
+fn seamanship_waterway_excursion_of_1_m_for_50_s() {
+    // Every corner 1 m beyond the half width from 200 s to 250 s (the hulls are 0.3 m
+    // wide: centres at 5 + 1 - 0.15 m).
+    let offset = |t: f64| {
+        if t > 200.0 && t <= 250.0 {
+            [0.0, HALF_WIDTH + 1.0 - 0.15]
+        } else {
+            [0.0, 0.0]
+        }
+    };
+    let r = run(800.0, cruise, offset, &[]);
+    let w = &r.waterway;
+    assert!(close(w.max_excess_m.expect("judged"), 1.0, 1e-9), "{w:?}");
+    assert_eq!(w.t_max_s, Some(200.5));
+    assert_eq!(w.max_vessel.as_deref(), Some("ship"));
+    assert!(close(w.time_outside_s, 50.0, 1e-9));
+    // One grounding event per vessel, all three over the same 100 steps.
+    assert_eq!(w.groundings.len(), 3, "{w:?}");
+    for (g, name) in w.groundings.iter().zip(["ship", "tug1", "tug2"]) {
+        assert_eq!(g.vessel, name);
+        assert_eq!((g.t_start_s, g.t_end_s, g.samples), (200.5, 250.0, 100));
+    }
+    assert_eq!(metrics(&verdict(&r)), ["waterway"; 3]);
+}
+
+#[test]
+fn seamanship_no_waterway_gives_no_waterway_reason() {
+    let offset = |_t: f64| [0.0, 20.0];
+    let g = RunGeometry {
+        half_width: None,
+        ..geometry()
+    };
+    let mut s = Seamanship::new(&g, &Thresholds::default());
+    let v = Vessel {
+        y: offset(0.0)[1],
+        ..Vessel::default()
+    };
+    s.push(&PlantStep {
+        t: 0.0,
+        vessels: [v; 3],
+        obstacles: &[],
+        control: None,
+    });
+    let r = s.finish();
+    assert_eq!(r.waterway.note.as_deref(), Some("no waterway"));
+    assert!(!metrics(&verdict(&r)).contains(&"waterway"));
+}
+
+#[test]
+fn seamanship_going_astern() {
+    let motion = |t: f64, p: [f64; 2]| {
+        if t > 300.0 && t <= 340.0 {
+            (0.0, -0.04, 0.0)
+        } else {
+            cruise(t, p)
+        }
+    };
+    // 0.04 m/s astern: below the under-way speed, so no drift angle (180 deg) is counted.
+    let r = run(900.0, motion, no_offset, &[]);
+    assert_eq!(r.astern.min_surge_m_s, Some(-0.04));
+    assert_eq!(r.astern.t_min_s, Some(300.5));
+    assert!(close(r.astern.time_astern_s, 40.0, 1e-9));
+    assert_eq!(metrics(&verdict(&r)), ["astern"]);
+}
+
+#[test]
+fn seamanship_speed_over_ground_spike() {
+    let motion = |t: f64, p: [f64; 2]| {
+        if t > 300.0 && t <= 310.0 {
+            (0.0, 2.0 * CRUISE, 0.0)
+        } else {
+            cruise(t, p)
+        }
+    };
+    let r = run(800.0, motion, no_offset, &[]);
+    assert!(close(r.speed.cruise_m_s.expect("under way"), CRUISE, 1e-4));
+    assert!(
+        close(r.speed.max_cruise_ratio.expect("ratio"), 2.0, 4e-3),
+        "{:?}",
+        r.speed
+    );
+    assert_eq!(r.speed.t_max_s, Some(300.5));
+    assert_eq!(metrics(&verdict(&r)), ["speed"]);
+}
+
+/// A target from port crossing the route eastward at 0.05 m/s, on a collision course with
+/// the ship at (26, 0) at 400 s.
+fn crossing_from_port() -> Target {
+    Target {
+        name: "port",
+        at_t0: [26.0, -0.05 * 400.0],
+        course_deg: 90.0,
+        speed: 0.05,
+    }
+}
+
+#[test]
+fn seamanship_stand_on_port_turn_for_a_port_target() {
+    let port_turn = |t: f64, p: [f64; 2]| {
+        if t > 300.0 {
+            (-20.0, CRUISE, 0.0)
+        } else {
+            cruise(t, p)
+        }
+    };
+    let r = run(600.0, port_turn, no_offset, &[crossing_from_port()]);
+    let target = &r.rules.targets[0];
+    assert_eq!(target.situation.as_deref(), Some("crossing stand-on"));
+    assert!(close(
+        target.port_turn_port_target_deg.expect("port side"),
+        20.0,
+        1e-9
+    ));
+    assert_eq!(target.t_port_turn_s, Some(300.5));
+    let why = verdict(&r);
+    let rule17: Vec<&Reason> = why
+        .iter()
+        .filter(|r| r.metric == "rule17_stand_on")
+        .collect();
+    assert!(
+        rule17.iter().any(|r| r.message.contains("to port")),
+        "{why:?}"
+    );
+    // Standing on: the same encounter without the turn gives no rule reason.
+    let r = run(600.0, cruise, no_offset, &[crossing_from_port()]);
+    assert_eq!(
+        r.rules.targets[0].situation.as_deref(),
+        Some("crossing stand-on")
+    );
+    assert!(
+        !verdict(&r).iter().any(|r| r.metric.starts_with("rule")),
+        "{:?}",
+        verdict(&r)
+    );
+}
+
+/// A target on the reciprocal course at cruise speed, `east` m off the route.
+fn head_on(east: f64) -> Target {
+    Target {
+        name: "head-on",
+        at_t0: [60.0, east],
+        course_deg: 180.0,
+        speed: CRUISE,
+    }
+}
+
+#[test]
+fn seamanship_head_on_port_to_port_with_a_starboard_turn_passes() {
+    // Detected at about 392 s (tug 2 within 7 m); 15 deg to starboard from 395 s to 500 s.
+    let turn = |t: f64, p: [f64; 2]| {
+        if t > 395.0 && t <= 500.0 {
+            (15.0, CRUISE, 0.0)
+        } else {
+            cruise(t, p)
+        }
+    };
+    let r = run(900.0, turn, no_offset, &[head_on(-0.3)]);
+    let target = &r.rules.targets[0];
+    assert_eq!(target.situation.as_deref(), Some("head-on"));
+    assert!(target.beta_cpa_deg.expect("cpa") < 0.0);
+    assert!(close(
+        target.starboard_turn_to_cpa_deg.expect("cpa"),
+        15.0,
+        1e-9
+    ));
+    assert_eq!(
+        target.past_and_clear.as_deref(),
+        Some("abaft the beam, opening")
+    );
+    assert!(target.t_past_and_clear_s.expect("past") < 500.0);
+    let why = verdict(&r);
+    assert!(why.is_empty(), "{why:?}");
+}
+
+#[test]
+fn seamanship_head_on_starboard_to_starboard_is_a_reason() {
+    let r = run(900.0, cruise, no_offset, &[head_on(1.0)]);
+    let target = &r.rules.targets[0];
+    assert_eq!(target.situation.as_deref(), Some("head-on"));
+    assert!(target.beta_cpa_deg.expect("cpa") > 0.0);
+    let why = verdict(&r);
+    assert!(
+        why.iter()
+            .any(|r| r.metric == "rule14_head_on" && r.message.contains("starboard to starboard")),
+        "{why:?}"
+    );
+    assert!(metrics(&why).contains(&"rule16_action"), "{why:?}");
+}
+
+#[test]
+fn seamanship_overtaking_too_close_is_a_reason() {
+    // A slower target on the same course 0.5 m to starboard of the route: side by side,
+    // the gap between the hulls (half widths 0.15 m) and the ellipse (semi-minor axis
+    // 0.24 m) is 0.5 - 0.15 - 0.24 = 0.11 m.
+    let slow = Target {
+        name: "slow",
+        at_t0: [10.0, 0.5],
+        course_deg: 0.0,
+        speed: 0.03,
+    };
+    let r = run(800.0, cruise, no_offset, &[slow]);
+    let target = &r.rules.targets[0];
+    assert_eq!(target.situation.as_deref(), Some("overtaking"));
+    assert!(
+        close(target.min_hull_clearance_m.expect("detected"), 0.11, 1e-9),
+        "{target:?}"
+    );
+    let why = verdict(&r);
+    assert!(
+        why.iter()
+            .any(|r| r.metric == "rule13_overtaking" && r.message.contains("clearance")),
+        "{why:?}"
+    );
+    // Kept its course and speed: no give-way action either.
+    assert!(metrics(&why).contains(&"rule16_action"), "{why:?}");
+    // 1 m to starboard instead: 0.61 m, no clearance reason.
+    let wide = Target {
+        name: "wide",
+        at_t0: [10.0, 1.0],
+        course_deg: 0.0,
+        speed: 0.03,
+    };
+    let r = run(800.0, cruise, no_offset, &[wide]);
+    assert!(close(
+        r.rules.targets[0].min_hull_clearance_m.expect("detected"),
+        0.61,
+        1e-9
+    ));
+    assert!(!verdict(&r).iter().any(|r| r.message.contains("clearance")));
+}
+
+#[test]
+fn seamanship_own_turn_is_not_the_target_crossing_ahead() {
+    // Head-on, the target 0.05 m to starboard of the route: the tow's 15 deg starboard
+    // turn puts it on the port side of the ship's heading line, but by the ship's motion,
+    // not the target's, so it is not past and clear until it is abaft the beam.
+    let turn = |t: f64, p: [f64; 2]| {
+        if t > 395.0 && t <= 500.0 {
+            (15.0, CRUISE, 0.0)
+        } else {
+            cruise(t, p)
+        }
+    };
+    let r = run(900.0, turn, no_offset, &[head_on(0.05)]);
+    let target = &r.rules.targets[0];
+    assert_eq!(target.situation.as_deref(), Some("head-on"));
+    assert_eq!(
+        target.past_and_clear.as_deref(),
+        Some("abaft the beam, opening"),
+        "{target:?}"
+    );
+    assert!(
+        target.t_past_and_clear_s.expect("past") > 450.0,
+        "{target:?}"
+    );
+    // Not given up; but the turn swings tug 2 (2 m ahead of the ship) across the target's
+    // course line ahead of it, within 7 m of it: that is a reason (Rule 14's crossing
+    // check), and the only one.
+    let why = verdict(&r);
+    assert_eq!(metrics(&why), ["rule14_head_on"], "{why:?}");
+    assert!(why[0].message.starts_with("tug2 crossed ahead"), "{why:?}");
+}
