@@ -332,7 +332,7 @@ def store(out, run, result):
     record = {"id": run["id"], "scenario": run["scenario"], "configuration": run["configuration"], "parameters": run["parameters"],
               "stop_time_s": run["stop_time"], **{k: v for k, v in result.items() if k != "id"}}
     tmp = d / "result.json.tmp"
-    tmp.write_text(json.dumps(record, indent=1, sort_keys=True) + "\n")
+    tmp.write_text(json.dumps(record, indent=1) + "\n")  # key order kept: summaries rebuilt from it read the same
     tmp.replace(d / "result.json")
     return record
 
