@@ -54,7 +54,7 @@ pub fn analyze_run(
             std::mem::take(&mut run.controller),
             &run.config.route,
         )?;
-        let mut stream = PlantStream::new(&run.config, &ctrl, tables, opts)?;
+        let mut stream = PlantStream::new(&run.config, &ctrl, tables, opts, thresholds)?;
         let bar = progress.add(crate::progress::bytes_bar(&run.plant_path));
         let read = crate::read::read_into(&run.plant_path, &bar, &mut stream);
         bar.finish_and_clear();

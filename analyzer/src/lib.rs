@@ -41,7 +41,6 @@ pub mod read;
 pub mod report;
 pub mod rows;
 pub mod run;
-pub mod seamanship;
 pub mod step;
 pub mod stream;
 pub mod synth;

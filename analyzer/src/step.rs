@@ -121,3 +121,24 @@ pub struct RunGeometry {
     /// Detection distance `d_D` for target ships, m.
     pub detection_distance: f64,
 }
+
+/// The time a step stands for: since the previous step (0 for the first step, and for a
+/// step not after the previous one). A plant step's `t` is the end of the step, so a
+/// condition holding at the steps with `t` in `(a, b]` on a regular grid lasts `b - a`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StepClock {
+    prev: Option<f64>,
+}
+
+impl StepClock {
+    /// The time since the previous call's `t`, s.
+    pub fn dt(&mut self, t: f64) -> f64 {
+        let dt = self.prev.map_or(0.0, |p| (t - p).max(0.0));
+        self.prev = Some(t);
+        if dt.is_finite() {
+            dt
+        } else {
+            0.0
+        }
+    }
+}

@@ -26,6 +26,7 @@ use crate::plot_sink::PlotSink;
 use crate::read::{Msg, PlantData, Sink};
 use crate::rows::StepBuilder;
 use crate::run::RunConfig;
+use crate::thresholds::Thresholds;
 
 /// Sizes of the streaming analysis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -145,7 +146,8 @@ impl std::fmt::Debug for PlantStream<'_> {
 
 impl<'a> PlantStream<'a> {
     /// A stream for a run with `config` and the controller's frames `ctrl`, writing the
-    /// `timeseries` and `obstacles` tables into `tables` when given.
+    /// `timeseries` and `obstacles` tables into `tables` when given; the metrics measure
+    /// against `thresholds`.
     ///
     /// # Errors
     /// The controller's reference table lacks a column (unexpected).
@@ -154,11 +156,13 @@ impl<'a> PlantStream<'a> {
         ctrl: &'a ControllerFrames,
         tables: Option<&Path>,
         opts: &StreamOptions,
+        thresholds: &Thresholds,
     ) -> Result<Self> {
         let geometry = config.geometry();
         let run = RunContext {
             config,
             geometry: &geometry,
+            thresholds,
         };
         Ok(PlantStream {
             opts: *opts,

@@ -2,7 +2,13 @@
 //! route North from (0, 0) to (50, 0), the ship at 0.065 m/s with the tugs 2 m ahead and
 //! behind on its heading, plant steps of 0.5 s, scripted departures from that.
 
-use analyzer::seamanship::{reasons, Seamanship, SeamanshipReport};
+use analyzer::metric::astern::{self, AsternReport, AsternTracker};
+use analyzer::metric::drift::{self, DriftReport, DriftTracker};
+use analyzer::metric::progress::{self, ProgressReport, ProgressTracker};
+use analyzer::metric::rules::{self, RulesReport, RulesTracker};
+use analyzer::metric::speed::{self, SpeedReport, SpeedTracker};
+use analyzer::metric::waterway::{self, WaterwayReport, WaterwayTracker};
+use analyzer::metric::{Metric, StepFacts};
 use analyzer::step::{Obstacle, ObstacleKind, PlantStep, RunGeometry, Vessel};
 use analyzer::thresholds::Thresholds;
 use analyzer::verdict::Reason;
@@ -44,6 +50,72 @@ impl Target {
             width: 0.48,
         }
     }
+}
+
+/// The six seamanship and rule metrics, fed as the registry feeds them (`rules` before
+/// `progress`, the step's facts handed on), without the log reading around them.
+struct Seamanship {
+    rules: RulesTracker,
+    progress: ProgressTracker,
+    drift: DriftTracker,
+    speed: SpeedTracker,
+    astern: AsternTracker,
+    waterway: WaterwayTracker,
+}
+
+/// Their reports.
+struct SeamanshipReport {
+    rules: RulesReport,
+    progress: ProgressReport,
+    drift: DriftReport,
+    speed: SpeedReport,
+    astern: AsternReport,
+    waterway: WaterwayReport,
+}
+
+impl Seamanship {
+    fn new(g: &RunGeometry, th: &Thresholds) -> Self {
+        Seamanship {
+            rules: RulesTracker::new(g, th),
+            progress: ProgressTracker::new(g, th),
+            drift: DriftTracker::new(g, th),
+            speed: SpeedTracker::new(g, th),
+            astern: AsternTracker::new(g, th),
+            waterway: WaterwayTracker::new(g, th),
+        }
+    }
+
+    fn push(&mut self, s: &PlantStep<'_>) {
+        let mut facts = StepFacts::default();
+        Metric::step(&mut self.rules, s, &mut facts);
+        Metric::step(&mut self.progress, s, &mut facts);
+        Metric::step(&mut self.drift, s, &mut facts);
+        Metric::step(&mut self.speed, s, &mut facts);
+        Metric::step(&mut self.astern, s, &mut facts);
+        Metric::step(&mut self.waterway, s, &mut facts);
+    }
+
+    fn finish(self) -> SeamanshipReport {
+        SeamanshipReport {
+            rules: self.rules.finish(),
+            progress: self.progress.finish(),
+            drift: self.drift.finish(),
+            speed: self.speed.finish(),
+            astern: self.astern.finish(),
+            waterway: self.waterway.finish(),
+        }
+    }
+}
+
+/// Every reason, metric by metric in the registry's order.
+fn reasons(r: &SeamanshipReport, th: &Thresholds) -> Vec<Reason> {
+    let mut out = rules::reasons(&r.rules, th);
+    out.extend(progress::reasons(&r.progress, th));
+    out.extend(drift::reasons(&r.drift, th));
+    out.extend(speed::reasons(&r.speed, th));
+    out.extend(astern::reasons(&r.astern, th));
+    out.extend(waterway::reasons(&r.waterway, th));
+    out
 }
 
 /// A run: `motion(t, ship position)` gives the ship's heading (deg), surge and sway at the

@@ -6,7 +6,9 @@ report files an older analyzer wrote, run from BASELINE with relative log paths)
 
 - encounters.csv: byte for byte;
 - metrics.json: equal as JSON after removing the wall-time fields (`sample_time_ms`) and
-  the keys an older metrics.json lacks (`verdict`, `thresholds`).
+  the top-level keys the baseline lacks (sections added since: `verdict`, `thresholds`,
+  new metrics; listed, not compared). A key the baseline has and the new output lacks,
+  or any changed value, is a difference.
 
 Usage: tests/tools/compare_baseline.py [--baseline DIR] [--out DIR] [--analyzer BIN]
 Exit status 0 when every run matches, 1 otherwise (each difference is printed).
@@ -76,11 +78,13 @@ def main():
         for k in NEW_KEYS:
             if k not in after:
                 problems.append(f"metrics.json lacks the new key {k}")
-        problems += [f"metrics.json {d}" for d in diff(strip(before), strip(after))[:20]]
+        added = sorted(set(after) - set(before))
         verdict = after.get("verdict", {})
+        after = {k: v for k, v in after.items() if k in before}
+        problems += [f"metrics.json {d}" for d in diff(strip(before), strip(after))[:20]]
         status = "identical" if not problems else "DIFFERENT"
         print(f"{run.name}: {status} (verdict passed={verdict.get('passed')}, "
-              f"{len(verdict.get('reasons', []))} reasons)")
+              f"{len(verdict.get('reasons', []))} reasons; new sections: {', '.join(added)})")
         for pr in problems:
             print(f"  {pr}")
         failed += bool(problems)

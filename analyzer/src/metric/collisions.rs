@@ -6,7 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{summary_row, FinishContext, Metric, Metrics, ReportPart, RunContext, Shared};
+use super::{StepFacts, summary_row, FinishContext, Metric, Metrics, ReportPart, RunContext, Shared};
 use crate::doc::Block;
 use crate::error::Result;
 use crate::frames::PlantBatch;
@@ -76,7 +76,7 @@ impl Metric for Collisions {
         }
     }
 
-    fn step(&mut self, s: &PlantStep<'_>) {
+    fn step(&mut self, s: &PlantStep<'_>, _facts: &mut StepFacts) {
         for (p, &(a, b)) in PAIRS.iter().enumerate() {
             let (va, vb) = (&s.vessels[a], &s.vessels[b]);
             let (sa, sb) = (self.sizes[a], self.sizes[b]);

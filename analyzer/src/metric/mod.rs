@@ -25,20 +25,6 @@ use crate::step::{PlantStep, RunGeometry};
 use crate::thresholds::Thresholds;
 use crate::verdict::Reason;
 
-pub mod bounds;
-pub mod collisions;
-pub mod distances;
-pub mod elongation;
-pub mod encounters;
-pub mod registry;
-pub mod run_info;
-pub mod settling;
-pub mod solver;
-pub mod travel;
-pub mod units;
-
-pub use registry::{Metrics, Trackers};
-
 /// What a metric knows of the run before the first step.
 #[derive(Debug, Clone, Copy)]
 pub struct RunContext<'a> {
@@ -46,6 +32,18 @@ pub struct RunContext<'a> {
     pub config: &'a RunConfig,
     /// Vessel sizes, route, waterway, detection distance.
     pub geometry: &'a RunGeometry,
+    /// The thresholds the run is judged by (metrics that measure against one while the
+    /// steps go by, e.g. the under-way speed, read it here).
+    pub thresholds: &'a Thresholds,
+}
+
+/// Facts a metric publishes at a plant step for the metrics registered after it
+/// ([`Metric::step`]), reset before every step.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct StepFacts {
+    /// The tow is giving way to a target ship that is not yet past and clear (the `rules`
+    /// metric; the `progress` metric excuses a stall while it holds).
+    pub giving_way: bool,
 }
 
 /// What a metric may read when it finishes: the controller's tables (read whole) and
@@ -98,8 +96,10 @@ pub trait Metric: Sized {
     /// The metric's state before the first step.
     fn new(run: &RunContext<'_>) -> Self;
 
-    /// One plant step (every step of the log, in time order).
-    fn step(&mut self, _step: &PlantStep<'_>) {}
+    /// One plant step (every step of the log, in time order). `facts` holds what the
+    /// metrics registered before this one published at this step; a metric may add its
+    /// own for those after it.
+    fn step(&mut self, _step: &PlantStep<'_>, _facts: &mut StepFacts) {}
 
     /// One batch of plant steps column-wise, before its steps are handed to
     /// [`Metric::step`]: the fast path of metrics that read the towline, input or
@@ -144,13 +144,15 @@ pub fn summary_row(metric: &str, value: String, definition: &str) -> [String; 3]
     [metric.to_owned(), value, definition.to_owned()]
 }
 
-/// Declares the registered metrics (invoked once, in [`registry`]): `key: Type` per metric (its section's key in
-/// `metrics.json`; `#[serde(flatten)]` puts the section's fields at the top level, as
-/// the metrics predating the registry have them). Generates [`Metrics`] (the sections in
+/// Declares the registered metrics (invoked once, at the end of this file): `key:
+/// module::Type` per metric (its section's key in `metrics.json`, the metric's module,
+/// declared here, and its type; `#[serde(flatten)]` puts the section's fields at the top
+/// level, as the metrics predating the registry have them). Generates [`Metrics`] (the sections in
 /// order, then `config`, `files`, `verdict`, `thresholds`) and [`Trackers`] (one state
 /// per metric, fed and finished in order).
 macro_rules! define_metrics {
-    ($( $(#[$attr:meta])* $key:ident : $ty:ty ),* $(,)?) => {
+    ($( $(#[$attr:meta])* $key:ident : $module:ident :: $ty:ident ),* $(,)?) => {
+        $( pub mod $module; )*
         /// Everything in `metrics.json`: one section per registered metric, the run's
         /// settings and files, the verdict and the thresholds it used.
         #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -158,7 +160,7 @@ macro_rules! define_metrics {
             $(
                 #[doc = concat!("Section of the `", stringify!($key), "` metric.")]
                 $(#[$attr])*
-                pub $key: <$ty as $crate::metric::Metric>::Section,
+                pub $key: <$module::$ty as $crate::metric::Metric>::Section,
             )*
             /// Sizes and settings used.
             pub config: $crate::run::RunConfig,
@@ -175,15 +177,14 @@ macro_rules! define_metrics {
         /// The state of every registered metric while the plant log streams by.
         #[derive(Debug)]
         pub struct Trackers {
-            $( $key: $ty, )*
+            $( $key: $module::$ty, )*
         }
 
         impl Trackers {
             /// Every metric's state before the first step.
             #[must_use]
             pub fn new(run: &$crate::metric::RunContext<'_>) -> Self {
-                use $crate::metric::Metric as _;
-                Trackers { $( $key: <$ty>::new(run), )* }
+                Trackers { $( $key: <$module::$ty as $crate::metric::Metric>::new(run), )* }
             }
 
             /// One batch column-wise, to every metric.
@@ -191,15 +192,14 @@ macro_rules! define_metrics {
             /// # Errors
             /// A frame lacks a column (unexpected).
             pub fn batch(&mut self, b: &$crate::frames::PlantBatch) -> $crate::error::Result<()> {
-                use $crate::metric::Metric as _;
-                $( self.$key.batch(b)?; )*
+                $( $crate::metric::Metric::batch(&mut self.$key, b)?; )*
                 Ok(())
             }
 
             /// One plant step, to every metric.
             pub fn step(&mut self, s: &$crate::step::PlantStep<'_>) {
-                use $crate::metric::Metric as _;
-                $( self.$key.step(s); )*
+                let mut facts = $crate::metric::StepFacts::default();
+                $( $crate::metric::Metric::step(&mut self.$key, s, &mut facts); )*
             }
 
             /// Every section, and the verdict under `thresholds`.
@@ -211,11 +211,10 @@ macro_rules! define_metrics {
                 ctx: &$crate::metric::FinishContext<'_>,
                 thresholds: &$crate::thresholds::Thresholds,
             ) -> $crate::error::Result<Metrics> {
-                use $crate::metric::Metric as _;
                 let mut shared = $crate::metric::Shared::default();
-                $( self.$key.share(ctx, &mut shared)?; )*
+                $( $crate::metric::Metric::share(&mut self.$key, ctx, &mut shared)?; )*
                 let mut m = Metrics {
-                    $( $key: self.$key.finish(ctx, &shared)?, )*
+                    $( $key: $crate::metric::Metric::finish(self.$key, ctx, &shared)?, )*
                     config: ctx.config.clone(),
                     files: ctx.files.to_vec(),
                     verdict: $crate::verdict::Verdict::default(),
@@ -234,19 +233,48 @@ macro_rules! define_metrics {
                 &self,
                 thresholds: &$crate::thresholds::Thresholds,
             ) -> Vec<$crate::verdict::Reason> {
-                use $crate::metric::Metric as _;
                 let mut r = Vec::new();
-                $( r.extend(<$ty>::reasons(&self.$key, thresholds)); )*
+                $(
+                    let mut part = <$module::$ty as $crate::metric::Metric>::reasons(&self.$key, thresholds);
+                    // Each metric's by time (stable: equal times keep the metric's order),
+                    // reasons without a time last.
+                    part.sort_by(|a, b| {
+                        a.t_s
+                            .unwrap_or(f64::INFINITY)
+                            .total_cmp(&b.t_s.unwrap_or(f64::INFINITY))
+                    });
+                    r.append(&mut part);
+                )*
                 r
             }
 
             /// Every registered metric's part of the report, in registration order.
             #[must_use]
             pub fn report_parts(&self) -> Vec<$crate::metric::ReportPart> {
-                use $crate::metric::Metric as _;
-                vec![ $( <$ty>::report(&self.$key, self), )* ]
+                vec![ $( <$module::$ty as $crate::metric::Metric>::report(&self.$key, self), )* ]
             }
         }
     };
 }
-pub(crate) use define_metrics;
+
+// The registered metrics, in the order of their sections in `metrics.json`, of their
+// parts of the report and of the verdict's reasons. A new metric: its module file in
+// this folder and one line here (docs/architecture.md, "How to add a metric").
+define_metrics! {
+    #[serde(flatten)] run: run_info::RunInfo,
+    #[serde(flatten)] settling: settling::Settling,
+    #[serde(flatten)] elongation: elongation::Elongation,
+    #[serde(flatten)] distances: distances::Distances,
+    #[serde(flatten)] collisions: collisions::Collisions,
+    #[serde(flatten)] travel: travel::Travel,
+    #[serde(flatten)] colregs: encounters::Encounters,
+    #[serde(flatten)] bounds: bounds::BoundChecks,
+    #[serde(flatten)] solver: solver::Solver,
+    #[serde(flatten)] units: units::UnitLogs,
+    rules: rules::RulesTracker,
+    progress: progress::ProgressTracker,
+    drift: drift::DriftTracker,
+    speed: speed::SpeedTracker,
+    astern: astern::AsternTracker,
+    waterway: waterway::WaterwayTracker,
+}

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{FinishContext, Metric, Metrics, ReportPart, RunContext, Shared};
+use super::{StepFacts, FinishContext, Metric, Metrics, ReportPart, RunContext, Shared};
 use crate::doc::Block;
 use crate::error::Result;
 use crate::step::PlantStep;
@@ -93,7 +93,7 @@ impl Metric for RunInfo {
         RunInfo::default()
     }
 
-    fn step(&mut self, s: &PlantStep<'_>) {
+    fn step(&mut self, s: &PlantStep<'_>, _facts: &mut StepFacts) {
         self.steps += 1;
         self.t_span = Some(self.t_span.map_or((s.t, s.t), |(a, _)| (a, s.t)));
     }

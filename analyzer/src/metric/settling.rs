@@ -5,7 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{summary_row, FinishContext, Metric, Metrics, ReportPart, RunContext, Shared};
+use super::{StepFacts, summary_row, FinishContext, Metric, Metrics, ReportPart, RunContext, Shared};
 use crate::doc::Block;
 use crate::error::Result;
 use crate::geometry::wrap;
@@ -58,7 +58,7 @@ impl Metric for Settling {
         }
     }
 
-    fn step(&mut self, s: &PlantStep<'_>) {
+    fn step(&mut self, s: &PlantStep<'_>, _facts: &mut StepFacts) {
         let v = s.vessels[0];
         let ship = [v.x, v.y, v.psi, v.u, v.v, v.r];
         self.settle

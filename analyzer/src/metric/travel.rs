@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{summary_row, FinishContext, Metric, Metrics, ReportPart, RunContext, Shared};
+use super::{StepFacts, summary_row, FinishContext, Metric, Metrics, ReportPart, RunContext, Shared};
 use crate::error::Result;
 use crate::metrics::TravelTracker;
 use crate::step::PlantStep;
@@ -28,7 +28,7 @@ impl Metric for Travel {
         Travel::default()
     }
 
-    fn step(&mut self, s: &PlantStep<'_>) {
+    fn step(&mut self, s: &PlantStep<'_>, _facts: &mut StepFacts) {
         self.travel.push(s.vessels[0].x, s.vessels[0].y);
     }
 

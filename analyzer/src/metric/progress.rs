@@ -18,8 +18,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::geometry::Polyline;
-use super::StepClock;
+use super::{summary_row, FinishContext, Metric, Metrics, ReportPart, RunContext, Shared, StepFacts};
+use crate::error::Result;
+
+use crate::geometry::Polyline;
+use crate::step::StepClock;
 use crate::step::{PlantStep, RunGeometry};
 use crate::thresholds::Thresholds;
 use crate::verdict::Reason;
@@ -226,4 +229,53 @@ pub fn reasons(report: &ProgressReport, thresholds: &Thresholds) -> Vec<Reason> 
         }
     }
     out
+}
+
+impl Metric for ProgressTracker {
+    type Section = ProgressReport;
+
+    fn new(run: &RunContext<'_>) -> Self {
+        ProgressTracker::new(run.geometry, run.thresholds)
+    }
+
+    /// Registered after `rules`, whose give-way state at this step excuses a stall.
+    fn step(&mut self, s: &PlantStep<'_>, facts: &mut StepFacts) {
+        self.push(s, facts.giving_way);
+    }
+
+    fn finish(self, _ctx: &FinishContext<'_>, _shared: &Shared) -> Result<ProgressReport> {
+        Ok(ProgressTracker::finish(self))
+    }
+
+    fn report(m: &ProgressReport, _all: &Metrics) -> ReportPart {
+        let stall = m.longest_stall.map_or_else(
+            || "none".to_owned(),
+            |s| {
+                format!(
+                    "{:.1} s from {:.1} s ({:.1} s of it giving way)",
+                    s.duration_s, s.t_start_s, s.giving_way_s
+                )
+            },
+        );
+        let arrival = match (m.time_to_destination_s, m.arrival_deadline_s) {
+            (Some(a), Some(d)) => format!("{a:.1} s (latest allowed: {d:.1} s)"),
+            (None, Some(d)) => format!("not reached (latest allowed: {d:.1} s)"),
+            _ => "no route".to_owned(),
+        };
+        ReportPart {
+            summary: vec![
+                summary_row(
+                    "longest stall",
+                    stall,
+                    "longest time without the least progress along the route, away from the destination",
+                ),
+                summary_row("time to destination", arrival, "first time the ship's centre is near the destination"),
+            ],
+            ..ReportPart::default()
+        }
+    }
+
+    fn reasons(m: &ProgressReport, thresholds: &Thresholds) -> Vec<Reason> {
+        reasons(m, thresholds)
+    }
 }

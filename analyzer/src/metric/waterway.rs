@@ -11,8 +11,13 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::geometry::Polyline;
-use super::{StepClock, VESSEL_NAMES};
+use super::{summary_row, FinishContext, Metric, Metrics, ReportPart, RunContext, Shared, StepFacts};
+use crate::doc::Block;
+use crate::error::Result;
+
+use crate::geometry::Polyline;
+use crate::rows::VESSELS;
+use crate::step::StepClock;
 use crate::geometry::hull_rect;
 use crate::step::{PlantStep, RunGeometry};
 use crate::thresholds::Thresholds;
@@ -110,7 +115,7 @@ impl WaterwayTracker {
                 }
                 (None, true) => {
                     self.current[k] = Some(Grounding {
-                        vessel: VESSEL_NAMES[k].to_owned(),
+                        vessel: VESSELS[k].to_owned(),
                         t_start_s: step.t,
                         t_end_s: step.t,
                         samples: 1,
@@ -140,7 +145,7 @@ impl WaterwayTracker {
             note: (!judged).then(|| "no waterway".to_owned()),
             max_excess_m: self.max.map(|m| m.0),
             t_max_s: self.max.map(|m| m.1),
-            max_vessel: self.max.map(|m| VESSEL_NAMES[m.2].to_owned()),
+            max_vessel: self.max.map(|m| VESSELS[m.2].to_owned()),
             time_outside_s: self.time_outside,
             groundings: self.events,
         }
@@ -166,4 +171,69 @@ pub fn reasons(report: &WaterwayReport, thresholds: &Thresholds) -> Vec<Reason> 
             )
         })
         .collect()
+}
+
+impl Metric for WaterwayTracker {
+    type Section = WaterwayReport;
+
+    fn new(run: &RunContext<'_>) -> Self {
+        WaterwayTracker::new(run.geometry, run.thresholds)
+    }
+
+    fn step(&mut self, s: &PlantStep<'_>, _facts: &mut StepFacts) {
+        self.push(s);
+    }
+
+    fn finish(self, _ctx: &FinishContext<'_>, _shared: &Shared) -> Result<WaterwayReport> {
+        Ok(WaterwayTracker::finish(self))
+    }
+
+    fn report(m: &WaterwayReport, _all: &Metrics) -> ReportPart {
+        let value = match (&m.note, m.max_excess_m, m.t_max_s, &m.max_vessel) {
+            (Some(note), ..) => note.clone(),
+            (None, Some(e), Some(t), Some(v)) => format!(
+                "{e:.2} m ({v}, {t:.1} s); {:.1} s outside; {} grounding(s)",
+                m.time_outside_s,
+                m.groundings.len()
+            ),
+            _ => "-".to_owned(),
+        };
+        let details = if m.groundings.is_empty() {
+            Vec::new()
+        } else {
+            vec![
+                Block::Heading(3, "Groundings".to_owned()),
+                Block::Table {
+                    headers: ["vessel", "from (s)", "to (s)", "largest excess (m)"]
+                        .map(str::to_owned)
+                        .to_vec(),
+                    rows: m
+                        .groundings
+                        .iter()
+                        .map(|g| {
+                            vec![
+                                g.vessel.clone(),
+                                format!("{:.1}", g.t_start_s),
+                                format!("{:.1}", g.t_end_s),
+                                format!("{:.2}", g.max_excess_m),
+                            ]
+                        })
+                        .collect(),
+                },
+            ]
+        };
+        ReportPart {
+            summary: vec![summary_row(
+                "waterway",
+                value,
+                "largest distance of a hull corner beyond the half width (negative: inside); a hull beyond the bank is a grounding",
+            )],
+            details,
+            ..ReportPart::default()
+        }
+    }
+
+    fn reasons(m: &WaterwayReport, thresholds: &Thresholds) -> Vec<Reason> {
+        reasons(m, thresholds)
+    }
 }

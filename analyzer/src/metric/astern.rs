@@ -4,7 +4,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::StepClock;
+use super::{summary_row, FinishContext, Metric, Metrics, ReportPart, RunContext, Shared, StepFacts};
+use crate::error::Result;
+
+use crate::step::StepClock;
 use crate::step::{PlantStep, RunGeometry};
 use crate::thresholds::Thresholds;
 use crate::verdict::Reason;
@@ -78,5 +81,40 @@ pub fn reasons(report: &AsternReport, thresholds: &Thresholds) -> Vec<Reason> {
             ),
         )],
         _ => Vec::new(),
+    }
+}
+
+impl Metric for AsternTracker {
+    type Section = AsternReport;
+
+    fn new(run: &RunContext<'_>) -> Self {
+        AsternTracker::new(run.geometry, run.thresholds)
+    }
+
+    fn step(&mut self, s: &PlantStep<'_>, _facts: &mut StepFacts) {
+        self.push(s);
+    }
+
+    fn finish(self, _ctx: &FinishContext<'_>, _shared: &Shared) -> Result<AsternReport> {
+        Ok(AsternTracker::finish(self))
+    }
+
+    fn report(m: &AsternReport, _all: &Metrics) -> ReportPart {
+        let value = match (m.min_surge_m_s, m.t_min_s) {
+            (Some(u), Some(t)) => format!("{u:.3} m/s at {t:.1} s; {:.1} s astern", m.time_astern_s),
+            _ => "-".to_owned(),
+        };
+        ReportPart {
+            summary: vec![summary_row(
+                "surge astern",
+                value,
+                "the ship's most negative surge speed, and the time it moved astern",
+            )],
+            ..ReportPart::default()
+        }
+    }
+
+    fn reasons(m: &AsternReport, thresholds: &Thresholds) -> Vec<Reason> {
+        reasons(m, thresholds)
     }
 }

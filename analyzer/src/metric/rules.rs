@@ -36,10 +36,14 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::geometry::{
+use super::{FinishContext, Metric, Metrics, ReportPart, RunContext, Shared, StepFacts};
+use crate::doc::Block;
+use crate::error::Result;
+
+use crate::geometry::{
     course_velocity, cpa_tcpa, hull_ellipse_clearance, line_coordinates, range_rate,
 };
-use super::VESSEL_NAMES;
+use crate::rows::VESSELS;
 use crate::colregs::{classify, Situation};
 use crate::geometry::{dist, relative_bearing, wrap};
 use crate::step::{Obstacle, ObstacleKind, PlantStep, RunGeometry, Vessel};
@@ -371,7 +375,7 @@ impl Target {
             {
                 self.r.crossed_ahead = Some(CrossAhead {
                     t_s: t,
-                    vessel: VESSEL_NAMES[k].to_owned(),
+                    vessel: VESSELS[k].to_owned(),
                     range_m: range,
                 });
             }
@@ -680,5 +684,77 @@ fn stand_on_reasons(r: &TargetRules, th: &Thresholds, out: &mut Vec<Reason>) {
                 ),
             ));
         }
+    }
+}
+
+/// A number with one decimal, or `-`.
+fn cell(v: Option<f64>) -> String {
+    v.map_or_else(|| "-".to_owned(), |x| format!("{x:.1}"))
+}
+
+impl Metric for RulesTracker {
+    type Section = RulesReport;
+
+    fn new(run: &RunContext<'_>) -> Self {
+        RulesTracker::new(run.geometry, run.thresholds)
+    }
+
+    /// Publishes whether a give-way encounter is open after this step (for `progress`).
+    fn step(&mut self, s: &PlantStep<'_>, facts: &mut StepFacts) {
+        self.push(s);
+        facts.giving_way = self.give_way_open();
+    }
+
+    fn finish(self, _ctx: &FinishContext<'_>, _shared: &Shared) -> Result<RulesReport> {
+        Ok(RulesTracker::finish(self))
+    }
+
+    fn report(m: &RulesReport, _all: &Metrics) -> ReportPart {
+        if m.targets.is_empty() {
+            return ReportPart::default();
+        }
+        let rows = m
+            .targets
+            .iter()
+            .map(|r| {
+                vec![
+                    r.target.clone(),
+                    r.situation.clone().unwrap_or_else(|| "-".to_owned()),
+                    r.situation_geometric.clone().unwrap_or_else(|| "-".to_owned()),
+                    cell(r.t_detect_s),
+                    r.action.clone().map_or_else(|| "-".to_owned(), |a| format!("{a} at {}", cell(r.t_action_s))),
+                    r.past_and_clear.clone().map_or_else(|| "-".to_owned(), |p| format!("{p} at {}", cell(r.t_past_and_clear_s))),
+                    r.given_up.map_or_else(|| "-".to_owned(), |g| format!("{:.1} s ({:.1} m, {:.0} deg)", g.t_s, g.range_m, g.bearing_deg)),
+                    cell(r.r_cpa_m),
+                    cell(r.beta_cpa_deg),
+                ]
+            })
+            .collect();
+        ReportPart {
+            details: vec![
+                Block::Heading(3, "Rule checks per target ship".to_owned()),
+                Block::Table {
+                    headers: [
+                        "target",
+                        "situation (judged)",
+                        "geometric",
+                        "detected (s)",
+                        "give-way action",
+                        "past and clear",
+                        "given up",
+                        "CPA range (m)",
+                        "CPA bearing (deg)",
+                    ]
+                    .map(str::to_owned)
+                    .to_vec(),
+                    rows,
+                },
+            ],
+            ..ReportPart::default()
+        }
+    }
+
+    fn reasons(m: &RulesReport, thresholds: &Thresholds) -> Vec<Reason> {
+        reasons(m, thresholds)
     }
 }

@@ -11,6 +11,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::{summary_row, FinishContext, Metric, Metrics, ReportPart, RunContext, Shared, StepFacts};
+use crate::error::Result;
+
 use crate::step::{PlantStep, RunGeometry};
 use crate::thresholds::Thresholds;
 use crate::verdict::Reason;
@@ -131,5 +134,40 @@ pub fn reasons(report: &SpeedReport, thresholds: &Thresholds) -> Vec<Reason> {
             )]
         }
         _ => Vec::new(),
+    }
+}
+
+impl Metric for SpeedTracker {
+    type Section = SpeedReport;
+
+    fn new(run: &RunContext<'_>) -> Self {
+        SpeedTracker::new(run.geometry, run.thresholds)
+    }
+
+    fn step(&mut self, s: &PlantStep<'_>, _facts: &mut StepFacts) {
+        self.push(s);
+    }
+
+    fn finish(self, _ctx: &FinishContext<'_>, _shared: &Shared) -> Result<SpeedReport> {
+        Ok(SpeedTracker::finish(self))
+    }
+
+    fn report(m: &SpeedReport, _all: &Metrics) -> ReportPart {
+        let value = match (m.cruise_m_s, m.max_sog_m_s, m.max_cruise_ratio) {
+            (Some(c), Some(v), Some(r)) => format!("{v:.3} m/s = {r:.2} x cruise ({c:.3} m/s)"),
+            _ => "never under way".to_owned(),
+        };
+        ReportPart {
+            summary: vec![summary_row(
+                "speed over ground",
+                value,
+                "the ship's largest speed over ground against its cruise (median while under way)",
+            )],
+            ..ReportPart::default()
+        }
+    }
+
+    fn reasons(m: &SpeedReport, thresholds: &Thresholds) -> Vec<Reason> {
+        reasons(m, thresholds)
     }
 }

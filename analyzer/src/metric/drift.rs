@@ -5,7 +5,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::StepClock;
+use super::{summary_row, FinishContext, Metric, Metrics, ReportPart, RunContext, Shared, StepFacts};
+use crate::error::Result;
+
+use crate::step::StepClock;
 use crate::geometry::wrap;
 use crate::step::{PlantStep, RunGeometry};
 use crate::thresholds::Thresholds;
@@ -95,5 +98,40 @@ pub fn reasons(report: &DriftReport, thresholds: &Thresholds) -> Vec<Reason> {
             ),
         )],
         _ => Vec::new(),
+    }
+}
+
+impl Metric for DriftTracker {
+    type Section = DriftReport;
+
+    fn new(run: &RunContext<'_>) -> Self {
+        DriftTracker::new(run.geometry, run.thresholds)
+    }
+
+    fn step(&mut self, s: &PlantStep<'_>, _facts: &mut StepFacts) {
+        self.push(s);
+    }
+
+    fn finish(self, _ctx: &FinishContext<'_>, _shared: &Shared) -> Result<DriftReport> {
+        Ok(DriftTracker::finish(self))
+    }
+
+    fn report(m: &DriftReport, all: &Metrics) -> ReportPart {
+        let value = match (m.max_drift_deg, m.t_max_s) {
+            (Some(d), Some(t)) => format!("{d:.1} deg at {t:.1} s; {:.1} s above {} deg", m.time_above_s, all.thresholds.drift_max_deg),
+            _ => "never under way".to_owned(),
+        };
+        ReportPart {
+            summary: vec![summary_row(
+                "drift angle",
+                value,
+                "largest angle between the ship's course over ground and its heading while under way",
+            )],
+            ..ReportPart::default()
+        }
+    }
+
+    fn reasons(m: &DriftReport, thresholds: &Thresholds) -> Vec<Reason> {
+        reasons(m, thresholds)
     }
 }
