@@ -611,3 +611,32 @@ fn seamanship_own_turn_is_not_the_target_crossing_ahead() {
     assert_eq!(metrics(&why), ["rule14_head_on"], "{why:?}");
     assert!(why[0].message.starts_with("tug2 crossed ahead"), "{why:?}");
 }
+
+#[test]
+fn seamanship_a_head_on_target_crossing_the_heading_line_ahead_is_not_past_until_abaft_the_beam() {
+    // Regression (paper run, target C): a head-on target moves along the tow's track, so
+    // its side of the ship's heading line changes with a small lateral drift of either
+    // vessel; that was read as "crossed ahead", past and clear 20 s before the alteration.
+    // Here the target drifts across the line ahead, 0.3 m to port to 0.4 m to starboard.
+    let drifting = Target {
+        name: "head-on",
+        at_t0: [60.0, -0.3],
+        course_deg: 178.0,
+        speed: CRUISE,
+    };
+    let r = run(900.0, cruise, no_offset, &[drifting]);
+    let target = &r.rules.targets[0];
+    assert_eq!(target.situation.as_deref(), Some("head-on"));
+    assert_eq!(
+        target.past_and_clear.as_deref(),
+        Some("abaft the beam, opening")
+    );
+    let (t_clear, t_cpa) = (
+        target.t_past_and_clear_s.expect("past"),
+        target.t_cpa_s.expect("cpa"),
+    );
+    assert!(
+        t_clear >= t_cpa - 1.0,
+        "past and clear at {t_clear} s, CPA at {t_cpa} s"
+    );
+}

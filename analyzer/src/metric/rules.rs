@@ -28,11 +28,14 @@
 //!   least `overtaking_clearance_m` ([`hull_ellipse_clearance`]).
 //!
 //! Past and clear (Rule 8(d)) is judged from the target's own motion relative to the tow,
-//! never from a range opened by the tow's braking: the target has crossed the ship's
-//! heading line ahead of the ship, moving across it (its side of the line changed between
-//! two steps, it was ahead of the ship, and its own velocity across the line points to the
-//! side it is now on, so the tow's own turn does not count), or it is abaft the ship's beam
-//! with the range opening while the tow makes way (surge > `way_off_surge_m_s`).
+//! never from a range opened by the tow's braking: in a crossing, the target has crossed
+//! the ship's heading line ahead of the ship by its own motion (between two steps it went
+//! from one side to the other of the line through the ship's pose at the earlier step, and
+//! is ahead of the ship: the line is held still over the step, so neither the tow's turn
+//! nor its sideways motion can make the crossing); in any situation, it is abaft the ship's
+//! beam with the range opening while the tow makes way (surge > `way_off_surge_m_s`). A
+//! head-on or overtaking target moves along the tow's track, not across it: its side of the
+//! heading line changes with a wobble of either vessel, so only the second test applies.
 
 use serde::{Deserialize, Serialize};
 
@@ -166,8 +169,8 @@ struct Target {
     controller: Option<Situation>,
     stbd_max: f64,
     acting: bool,
-    /// The target's last side (non-zero) of the ship's heading line.
-    prev_side: Option<f64>,
+    /// The ship's position and heading, and the target's position, at the previous step.
+    prev_pose: Option<([f64; 2], f64, [f64; 2])>,
     /// Each vessel's last side (non-zero) of the target's course line.
     prev_cross: [Option<f64>; 3],
 }
@@ -212,7 +215,7 @@ impl Target {
             controller: None,
             stbd_max: 0.0,
             acting: false,
-            prev_side: None,
+            prev_pose: None,
             prev_cross: [None; 3],
         }
     }
@@ -300,18 +303,22 @@ impl Target {
     /// Rule 8(d): latches past and clear (see the module's doc).
     fn past_and_clear(&mut self, t: f64, ship: &Vessel, o: &Obstacle, th: &Thresholds) {
         let (sp, tp) = ([ship.x, ship.y], [o.x, o.y]);
-        let (along, side) = line_coordinates(sp, ship.psi, tp);
-        let prev = self.prev_side;
-        if side != 0.0 {
-            self.prev_side = Some(side);
-        }
+        let prev = self.prev_pose.replace((sp, ship.psi, tp));
         if self.r.t_past_and_clear_s.is_some() {
             return;
         }
-        // The target's own velocity across the ship's heading line (+ to starboard).
-        let across_speed = o.speed * (o.course - ship.psi).sin();
-        let crossed =
-            prev.is_some_and(|p| p * side < 0.0) && along > 0.0 && across_speed * side > 0.0;
+        let crossing = !matches!(
+            self.situation(),
+            Some(Situation::HeadOn | Situation::Overtaking | Situation::BeingOvertaken)
+        );
+        // The line through the ship's previous pose, held still over the step: only the
+        // target's own motion moves it across.
+        let crossed = crossing
+            && prev.is_some_and(|(p_ship, p_psi, p_target)| {
+                let (_, before) = line_coordinates(p_ship, p_psi, p_target);
+                let (along, now) = line_coordinates(p_ship, p_psi, tp);
+                before != 0.0 && before * now <= 0.0 && along > 0.0
+            });
         let beta = relative_bearing(sp, ship.psi, tp);
         let opening = range_rate(sp, ship.vel_n(), tp, course_velocity(o.course, o.speed)) > 0.0;
         let abaft =
