@@ -24,7 +24,10 @@ use std::borrow::Cow;
 use polars::prelude::*;
 
 use crate::error::{AnalyzerError, Result};
-use crate::read::{ColregsCols, ControllerData, PlantData, VesselCols};
+use crate::read::{
+    ColregsCols, CommandCols, ControllerData, InputCols, ObstacleCols, PlantData, ReferenceCols,
+    SolverCols, TowlineCols, VesselCols,
+};
 
 /// The controller's tables (the whole controller log). The joined `controller` table and
 /// the long `colregs` table are never whole in memory: they are built per window of rows
@@ -414,7 +417,30 @@ pub fn build_plant_batch(
         obstacles,
         inputs,
     } = plant;
+    let vessels = vessels_frame(ship, tug1, tug2, carry)?;
+    let towlines = towlines_frame(towlines, carry)?;
+    let inputs = inputs_frame(inputs)?;
+    let obstacles = obstacles_frame(obstacles, &vessels, carry, ctrl)?;
+    let towlines_join = with_carry(&mut carry.towlines, towlines.clone(), "timeseries")?;
+    let inputs_join = with_carry(&mut carry.inputs, inputs.clone(), "timeseries")?;
+    Ok(PlantBatch {
+        vessels,
+        towlines,
+        inputs,
+        obstacles,
+        towlines_join,
+        inputs_join,
+    })
+}
 
+/// The `vessels` frame: the tugs as-of joined onto the ship's times (their last rows
+/// carried in `carry`).
+fn vessels_frame(
+    ship: VesselCols,
+    tug1: VesselCols,
+    tug2: VesselCols,
+    carry: &mut Carry,
+) -> Result<DataFrame> {
     let ship_df = frame("vessels", vessel_columns("ship", ship, true))?;
     let tug1_df = with_carry(
         &mut carry.tug1,
@@ -426,37 +452,43 @@ pub fn build_plant_batch(
         frame("vessels", vessel_columns("tug2", tug2, false))?,
         "vessels",
     )?;
-    let vessels = asof(&asof(&ship_df, &tug1_df, "vessels")?, &tug2_df, "vessels")?;
-    drop((ship_df, tug1_df, tug2_df));
+    asof(&asof(&ship_df, &tug1_df, "vessels")?, &tug2_df, "vessels")
+}
 
-    let [l1, l2] = towlines;
-    let line_cols = |k: usize, l: crate::read::TowlineCols| {
-        let mut c = Vec::with_capacity(7);
-        c.push(i64_col("t_ns", l.t_ns));
-        c.push(f64_col(&format!("line{k}_length"), l.length));
-        c.push(f64_col(&format!("line{k}_angle"), l.angle));
-        c.push(f64_col(&format!("line{k}_tension"), l.tension));
-        c.push(f64_col(&format!("line{k}_tension_cmd"), l.tension_cmd));
-        c.push(bool_col(&format!("line{k}_slack"), &l.slack));
-        c.push(f64_col(
-            &format!("line{k}_elongation_error"),
-            l.elongation_error,
-        ));
-        c
-    };
-    let l1_df = frame("towlines", line_cols(1, l1))?;
+/// The columns `t_ns`, `line{k}_*` of towline `k`.
+fn towline_columns(k: usize, l: TowlineCols) -> Vec<Column> {
+    let mut c = Vec::with_capacity(7);
+    c.push(i64_col("t_ns", l.t_ns));
+    c.push(f64_col(&format!("line{k}_length"), l.length));
+    c.push(f64_col(&format!("line{k}_angle"), l.angle));
+    c.push(f64_col(&format!("line{k}_tension"), l.tension));
+    c.push(f64_col(&format!("line{k}_tension_cmd"), l.tension_cmd));
+    c.push(bool_col(&format!("line{k}_slack"), &l.slack));
+    c.push(f64_col(
+        &format!("line{k}_elongation_error"),
+        l.elongation_error,
+    ));
+    c
+}
+
+/// The `towlines` frame: towline 2 as-of joined onto towline 1's times (its last row
+/// carried in `carry`).
+fn towlines_frame([l1, l2]: [TowlineCols; 2], carry: &mut Carry) -> Result<DataFrame> {
+    let l1_df = frame("towlines", towline_columns(1, l1))?;
     let l2_df = with_carry(
         &mut carry.line2,
-        frame("towlines", line_cols(2, l2))?,
+        frame("towlines", towline_columns(2, l2))?,
         "towlines",
     )?;
-    let towlines = asof(&l1_df, &l2_df, "towlines")?;
-    drop((l1_df, l2_df));
+    asof(&l1_df, &l2_df, "towlines")
+}
 
+/// The `inputs` frame.
+fn inputs_frame(inputs: InputCols) -> Result<DataFrame> {
     let [i1x, i1y, i1n] = inputs.tug1;
     let [i2x, i2y, i2n] = inputs.tug2;
     let [ic1, ic2] = inputs.tension_cmd;
-    let inputs = frame(
+    frame(
         "inputs",
         vec![
             i64_col("t_ns", inputs.t_ns),
@@ -469,10 +501,20 @@ pub fn build_plant_batch(
             f64_col("in_tension_cmd1", ic1),
             f64_col("in_tension_cmd2", ic2),
         ],
-    )?;
+    )
+}
 
+/// The `obstacles` frame: the obstacle rows with the poses of `vessels` joined as of their
+/// time (the last vessel row carried in `carry`), the centre distances
+/// ([`with_distances`]) and the guidance's alteration flag of `ctrl`.
+fn obstacles_frame(
+    obstacles: ObstacleCols,
+    vessels: &DataFrame,
+    carry: &mut Carry,
+    ctrl: &ControllerFrames,
+) -> Result<DataFrame> {
     let name_col = str_col("name", (0..obstacles.t_ns.len()).map(|i| obstacles.name(i)));
-    let crate::read::ObstacleCols {
+    let ObstacleCols {
         t_ns,
         slot,
         kind,
@@ -513,18 +555,7 @@ pub fn build_plant_batch(
     // The guidance's alteration flag beside each obstacle row (for the COLREGS first
     // action).
     let (lo, hi) = time_span(&obstacles, "obstacles")?;
-    let obstacles = asof(&obstacles, &ctrl.altered_window(lo, hi)?, "obstacles")?;
-
-    let towlines_join = with_carry(&mut carry.towlines, towlines.clone(), "timeseries")?;
-    let inputs_join = with_carry(&mut carry.inputs, inputs.clone(), "timeseries")?;
-    Ok(PlantBatch {
-        vessels,
-        towlines,
-        inputs,
-        obstacles,
-        towlines_join,
-        inputs_join,
-    })
+    asof(&obstacles, &ctrl.altered_window(lo, hi)?, "obstacles")
 }
 
 /// Builds the controller's frames, taking the columns over. `route` (origin, waypoints,
@@ -543,6 +574,27 @@ pub fn build_controller(
         command,
         solver,
     } = controller;
+    let reference = reference_frame(reference, route)?;
+    let (colregs, colregs_order) = compact_colregs(colregs);
+    let command = command_frame(command)?;
+    let solver_df = solver_frame(solver)?;
+
+    // The controller's topics on one base: the longest of solver, command, reference.
+    let heights = [solver_df.height(), command.height(), reference.height()];
+    let base = (0..3).max_by_key(|&k| heights[k]).unwrap_or(0);
+    Ok(ControllerFrames {
+        reference,
+        colregs,
+        colregs_order,
+        command,
+        solver: solver_df,
+        base,
+    })
+}
+
+/// The `reference` frame, with `altered_effective`: whether an alteration of the waypoint
+/// was in effect, given the `route` (origin, waypoints, destination).
+fn reference_frame(reference: ReferenceCols, route: &[[f64; 3]]) -> Result<DataFrame> {
     let [wpx, wpy, wpp] = reference.waypoint;
     // The guidance's `altered` is its decision; with avoidance scheme III the MPC still
     // tracks the route's waypoint. An alteration is in effect when the waypoint used
@@ -557,7 +609,7 @@ pub fn build_controller(
                     .is_none_or(|p| (p[0] - wpx[i]).hypot(p[1] - wpy[i]) > 1e-6)
         })
         .collect();
-    let reference = frame(
+    frame(
         "reference",
         vec![
             i64_col("t_ns", reference.t_ns),
@@ -572,9 +624,12 @@ pub fn build_controller(
             f64_col("wp_y", wpy),
             f64_col("wp_psi", wpp),
         ],
-    )?;
-    // The colregs rows stay compact; a stable time order if they are not in one.
-    let mut colregs = colregs;
+    )
+}
+
+/// The colregs rows, kept compact (vectors shrunk to fit), with their stable time order if
+/// they are not in one.
+fn compact_colregs(mut colregs: ColregsCols) -> (ColregsCols, Option<Vec<usize>>) {
     let in_order = colregs.t_ns.windows(2).all(|w| w[0] <= w[1]);
     let colregs_order = (!in_order).then(|| {
         let mut order: Vec<usize> = (0..colregs.t_ns.len()).collect();
@@ -587,11 +642,16 @@ pub fn build_controller(
     colregs.role_idx.shrink_to_fit();
     colregs.situation_code.shrink_to_fit();
     colregs.role_code.shrink_to_fit();
+    (colregs, colregs_order)
+}
+
+/// The `command` frame.
+fn command_frame(command: CommandCols) -> Result<DataFrame> {
     let [c1x, c1y, c1n] = command.tug1;
     let [c2x, c2y, c2n] = command.tug2;
     let [ct1, ct2] = command.tension;
     let [ca1, ca2] = command.desired_angle;
-    let command = frame(
+    frame(
         "command",
         vec![
             i64_col("t_ns", command.t_ns),
@@ -606,7 +666,11 @@ pub fn build_controller(
             f64_col("cmd_angle1", ca1),
             f64_col("cmd_angle2", ca2),
         ],
-    )?;
+    )
+}
+
+/// The `solver` frame, with the fallback reasons by name.
+fn solver_frame(solver: SolverCols) -> Result<DataFrame> {
     let fallback_col = opt_str_col(
         "fallback",
         solver.fallback_idx.iter().map(|k| {
@@ -614,7 +678,7 @@ pub fn build_controller(
                 .map(String::as_str)
         }),
     );
-    let crate::read::SolverCols {
+    let SolverCols {
         t_ns,
         architecture,
         scheme,
@@ -627,7 +691,7 @@ pub fn build_controller(
         fallbacks,
         ..
     } = solver;
-    let solver_df = frame(
+    frame(
         "solver",
         vec![
             i64_col("t_ns", t_ns),
@@ -644,19 +708,7 @@ pub fn build_controller(
             u64_col("fallbacks", fallbacks),
             fallback_col,
         ],
-    )?;
-
-    // The controller's topics on one base: the longest of solver, command, reference.
-    let heights = [solver_df.height(), command.height(), reference.height()];
-    let base = (0..3).max_by_key(|&k| heights[k]).unwrap_or(0);
-    Ok(ControllerFrames {
-        reference,
-        colregs,
-        colregs_order,
-        command,
-        solver: solver_df,
-        base,
-    })
+    )
 }
 
 /// Adds the centre distances `d_ship`, `d_tug1`, `d_tug2` (m) to the joined obstacle

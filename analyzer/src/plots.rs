@@ -8,12 +8,13 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::error::{AnalyzerError, Result};
 use crate::geometry::{body_to_ned, circle, ellipse, hull_outline};
-use crate::plot_sink::PlotData;
+use crate::plot_sink::{ObstacleTrack, PlotData};
 
 /// DejaVu Sans (Bitstream Vera license, `assets/DejaVuSans-LICENSE.txt`).
 static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
@@ -63,6 +64,8 @@ const HAZARD: RGBColor = RGBColor(90, 90, 90);
 const BOUND: RGBColor = RGBColor(220, 60, 20);
 const ROUTE: RGBColor = RGBColor(120, 120, 120);
 const ALTERED: RGBColor = RGBColor(240, 150, 0);
+/// Ship, tug 1, tug 2.
+const TOW_COLORS: [RGBColor; 3] = [SHIP, TUG1, TUG2];
 
 /// One written plot.
 #[derive(Debug, Clone, PartialEq)]
@@ -80,6 +83,9 @@ pub struct PlotFile {
 }
 
 type DrawResult = std::result::Result<(), Box<dyn std::error::Error>>;
+
+/// The map's chart: East horizontal, North vertical, m.
+type MapChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// Line styles of a series.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -594,6 +600,7 @@ fn en(p: [f64; 2]) -> (f64, f64) {
     (p[1], p[0])
 }
 
+/// Draws the map (the paper's Fig. 8 style) on `root`: East range `er`, North range `nr`, m.
 fn draw_map<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     d: &PlotData,
@@ -618,8 +625,31 @@ where
         .axis_desc_style((FAMILY, 16))
         .light_line_style(RGBColor(238, 238, 238))
         .draw()?;
+    draw_route(&mut chart, d)?;
+    draw_hazards(&mut chart, d)?;
+    let samples = sample_indices(&d.poses.t, 10);
+    let sample_times: Vec<f64> = samples.iter().map(|&i| d.poses.t[i]).collect();
+    draw_targets(&mut chart, d, &sample_times)?;
+    // The tow: tracks, then hull outlines and towlines at the sampled times.
+    draw_tow_tracks(&mut chart, d)?;
+    for &i in &samples {
+        draw_tow_at(&mut chart, d, i)?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.9))
+        .border_style(RGBColor(180, 180, 180))
+        .label_font((FAMILY, 14))
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()?;
+    Ok(())
+}
 
-    // Route and waypoints.
+/// Route and waypoints, the destination, the altered waypoints.
+fn draw_route<DB: DrawingBackend>(chart: &mut MapChart<'_, DB>, d: &PlotData) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
     let route: Vec<(f64, f64)> = d.route.iter().map(|p| (p[1], p[0])).collect();
     chart
         .draw_series(DashedLineSeries::new(
@@ -644,8 +674,14 @@ where
             .label("altered waypoints")
             .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, ALTERED.filled()));
     }
+    Ok(())
+}
 
-    // Static hazards with their safe circles (ship's safe distance, eq. (14)).
+/// Static hazards with their safe circles (ship's safe distance, eq. (14)).
+fn draw_hazards<DB: DrawingBackend>(chart: &mut MapChart<'_, DB>, d: &PlotData) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
     let mut hazard_legend = false;
     for o in d.obstacles.iter().filter(|o| o.kind != 2) {
         let (Some(&x), Some(&y)) = (o.x.first(), o.y.first()) else {
@@ -677,10 +713,19 @@ where
             (FAMILY, 18).into_font().color(&BLACK),
         )))?;
     }
+    Ok(())
+}
 
-    // Target ships: tracks, and outlines at the sampled times when active.
-    let samples = sample_indices(&d.poses.t, 10);
-    let sample_times: Vec<f64> = samples.iter().map(|&i| d.poses.t[i]).collect();
+/// Target ships: tracks, and outlines at the sampled times (`sample_times`, s) when
+/// active.
+fn draw_targets<DB: DrawingBackend>(
+    chart: &mut MapChart<'_, DB>,
+    d: &PlotData,
+    sample_times: &[f64],
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
     let mut target_legend = false;
     for o in d.obstacles.iter().filter(|o| o.kind == 2) {
         let track: Vec<(f64, f64)> = o.x.iter().zip(&o.y).map(|(&x, &y)| (y, x)).collect();
@@ -706,26 +751,12 @@ where
             _ => 0.0,
         };
         let tolerance = (2.0 * spacing).max(1.0);
-        for &ts in &sample_times {
+        for &ts in sample_times {
             let k = o.t.partition_point(|&v| v < ts);
             if k >= o.t.len() || (o.t[k] - ts).abs() > tolerance {
                 continue;
             }
-            let mut outline: Vec<(f64, f64)> =
-                ellipse(o.x[k], o.y[k], o.psi[k], o.length / 2.0, o.width / 2.0, 40)
-                    .into_iter()
-                    .map(en)
-                    .collect();
-            chart.draw_series(std::iter::once(Polygon::new(
-                outline.clone(),
-                TARGET.mix(0.25).filled(),
-            )))?;
-            if let Some(&f) = outline.first() {
-                outline.push(f);
-            }
-            chart.draw_series(std::iter::once(PathElement::new(outline, TARGET)))?;
-            let bow = body_to_ned(o.x[k], o.y[k], o.psi[k], o.length / 2.0, 0.0);
-            chart.draw_series(std::iter::once(Circle::new(en(bow), 2, TARGET.filled())))?;
+            draw_target_outline(chart, o, k)?;
         }
         if let (Some(&x), Some(&y)) = (o.x.first(), o.y.first()) {
             chart.draw_series(std::iter::once(Text::new(
@@ -735,14 +766,46 @@ where
             )))?;
         }
     }
+    Ok(())
+}
 
-    // The tow: tracks, then hull outlines and towlines at the sampled times.
-    let colors = [SHIP, TUG1, TUG2];
+/// The outline of target ship `o` at its row `k`, with a dot at the bow.
+fn draw_target_outline<DB: DrawingBackend>(
+    chart: &mut MapChart<'_, DB>,
+    o: &ObstacleTrack,
+    k: usize,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    let mut outline: Vec<(f64, f64)> =
+        ellipse(o.x[k], o.y[k], o.psi[k], o.length / 2.0, o.width / 2.0, 40)
+            .into_iter()
+            .map(en)
+            .collect();
+    chart.draw_series(std::iter::once(Polygon::new(
+        outline.clone(),
+        TARGET.mix(0.25).filled(),
+    )))?;
+    if let Some(&f) = outline.first() {
+        outline.push(f);
+    }
+    chart.draw_series(std::iter::once(PathElement::new(outline, TARGET)))?;
+    let bow = body_to_ned(o.x[k], o.y[k], o.psi[k], o.length / 2.0, 0.0);
+    chart.draw_series(std::iter::once(Circle::new(en(bow), 2, TARGET.filled())))?;
+    Ok(())
+}
+
+/// The tracks of ship, tug 1 and tug 2, with their legend entries.
+fn draw_tow_tracks<DB: DrawingBackend>(chart: &mut MapChart<'_, DB>, d: &PlotData) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
     let labels = ["ship", "tug 1 (aft)", "tug 2 (forward)"];
     for k in 0..3 {
         // decimate_points() keeps the samples' order, so the track stays a path.
         let pts = decimate_points(d.tracks[k].clone());
-        let color = colors[k];
+        let color = TOW_COLORS[k];
         chart
             .draw_series(LineSeries::new(
                 pts,
@@ -753,67 +816,71 @@ where
                 PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
             });
     }
-    for &i in &samples {
-        let pose = |k: usize| {
-            let [x, y, psi] = d.poses.pose[i][k];
-            (x, y, psi)
-        };
-        let (sx, sy, sp) = pose(0);
-        if !(sx.is_finite() && sy.is_finite() && sp.is_finite()) {
+    Ok(())
+}
+
+/// The towlines and hull outlines of the tow at pose sample `i`, labelled with its time
+/// (nothing when the ship's pose is not finite).
+fn draw_tow_at<DB: DrawingBackend>(
+    chart: &mut MapChart<'_, DB>,
+    d: &PlotData,
+    i: usize,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    let pose = |k: usize| {
+        let [x, y, psi] = d.poses.pose[i][k];
+        (x, y, psi)
+    };
+    let (sx, sy, sp) = pose(0);
+    if !(sx.is_finite() && sy.is_finite() && sp.is_finite()) {
+        return Ok(());
+    }
+    // Towlines: ship stern to tug 1 bow, ship bow to tug 2 stern (attachment points
+    // approximated by the hull ends).
+    let ls = d.sizes[0][0] / 2.0;
+    for (k, ship_end, tug_end) in [
+        (1usize, -ls, d.sizes[1][0] / 2.0),
+        (2, ls, -d.sizes[2][0] / 2.0),
+    ] {
+        let (tx, ty, tp) = pose(k);
+        if !(tx.is_finite() && ty.is_finite() && tp.is_finite()) {
             continue;
         }
-        // Towlines: ship stern to tug 1 bow, ship bow to tug 2 stern (attachment points
-        // approximated by the hull ends).
-        let ls = d.sizes[0][0] / 2.0;
-        for (k, ship_end, tug_end) in [
-            (1usize, -ls, d.sizes[1][0] / 2.0),
-            (2, ls, -d.sizes[2][0] / 2.0),
-        ] {
-            let (tx, ty, tp) = pose(k);
-            if !(tx.is_finite() && ty.is_finite() && tp.is_finite()) {
-                continue;
-            }
-            let a = body_to_ned(sx, sy, sp, ship_end, 0.0);
-            let b = body_to_ned(tx, ty, tp, tug_end, 0.0);
-            chart.draw_series(std::iter::once(PathElement::new(
-                vec![en(a), en(b)],
-                BLACK.stroke_width(1),
-            )))?;
-        }
-        for (k, color) in colors.iter().enumerate() {
-            let (x, y, p) = pose(k);
-            if !(x.is_finite() && y.is_finite() && p.is_finite()) {
-                continue;
-            }
-            let mut hull: Vec<(f64, f64)> = hull_outline(x, y, p, d.sizes[k][0], d.sizes[k][1])
-                .into_iter()
-                .map(en)
-                .collect();
-            chart.draw_series(std::iter::once(Polygon::new(
-                hull.clone(),
-                color.mix(0.35).filled(),
-            )))?;
-            if let Some(&f) = hull.first() {
-                hull.push(f);
-            }
-            chart.draw_series(std::iter::once(PathElement::new(
-                hull,
-                color.stroke_width(1),
-            )))?;
-        }
-        chart.draw_series(std::iter::once(Text::new(
-            format!("{:.0} s", d.poses.t[i]),
-            (sy + 0.9, sx + 0.4),
-            (FAMILY, 13).into_font().color(&BLACK),
+        let a = body_to_ned(sx, sy, sp, ship_end, 0.0);
+        let b = body_to_ned(tx, ty, tp, tug_end, 0.0);
+        chart.draw_series(std::iter::once(PathElement::new(
+            vec![en(a), en(b)],
+            BLACK.stroke_width(1),
         )))?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.9))
-        .border_style(RGBColor(180, 180, 180))
-        .label_font((FAMILY, 14))
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()?;
+    for (k, color) in TOW_COLORS.iter().enumerate() {
+        let (x, y, p) = pose(k);
+        if !(x.is_finite() && y.is_finite() && p.is_finite()) {
+            continue;
+        }
+        let mut hull: Vec<(f64, f64)> = hull_outline(x, y, p, d.sizes[k][0], d.sizes[k][1])
+            .into_iter()
+            .map(en)
+            .collect();
+        chart.draw_series(std::iter::once(Polygon::new(
+            hull.clone(),
+            color.mix(0.35).filled(),
+        )))?;
+        if let Some(&f) = hull.first() {
+            hull.push(f);
+        }
+        chart.draw_series(std::iter::once(PathElement::new(
+            hull,
+            color.stroke_width(1),
+        )))?;
+    }
+    chart.draw_series(std::iter::once(Text::new(
+        format!("{:.0} s", d.poses.t[i]),
+        (sy + 0.9, sx + 0.4),
+        (FAMILY, 13).into_font().color(&BLACK),
+    )))?;
     Ok(())
 }
 

@@ -710,38 +710,8 @@ fn scan(
         path: path.to_owned(),
         source,
     };
-    let file = File::open(path).map_err(io_err)?;
-    let bytes = file.metadata().map_err(io_err)?.len();
-    if bytes == 0 {
-        return Err(AnalyzerError::Empty {
-            path: path.to_owned(),
-        });
-    }
-    progress.set_length(bytes);
-    progress.set_position(0);
-    let mut source = BufReader::with_capacity(
-        1 << 20,
-        Counting {
-            inner: file,
-            progress: progress.clone(),
-        },
-    );
-
-    let mut log = LogFile {
-        path: path.to_owned(),
-        unit: Unit::Plant,
-        metadata: BTreeMap::new(),
-        scenario_text: None,
-        message_counts: BTreeMap::new(),
-        decode_errors: BTreeMap::new(),
-        truncated: None,
-        schema_mismatches: Vec::new(),
-        bytes,
-        plant: PlantData::default(),
-        controller: ControllerData::default(),
-        logs: Vec::new(),
-        decoded: Decoded::default(),
-    };
+    let (mut source, bytes) = open_counted(path, progress)?;
+    let mut log = nothing_read(path, bytes);
     let mut channels: BTreeMap<u16, ChannelInfo> = BTreeMap::new();
     let mut schema_names: BTreeMap<u16, String> = BTreeMap::new();
     let mut reader = LinearReader::new();
@@ -789,55 +759,15 @@ fn scan(
                     Record::Schema { header, .. } => {
                         schema_names.insert(header.id, header.name);
                     }
-                    Record::Channel(ch) => {
-                        let kind = classify(&ch.topic);
-                        let json = ch.message_encoding == topics::MESSAGE_ENCODING;
-                        if let (Some(expected), Some(found)) =
-                            (expected_schema(kind), schema_names.get(&ch.schema_id))
-                        {
-                            if expected != found {
-                                log.schema_mismatches.push(format!(
-                                    "{}: schema `{found}`, docs/logging.md says `{expected}`",
-                                    ch.topic
-                                ));
-                            }
-                        }
-                        channels.insert(
-                            ch.id,
-                            ChannelInfo {
-                                topic: ch.topic,
-                                kind,
-                                json,
-                            },
-                        );
-                    }
+                    Record::Channel(ch) => add_channel(&mut log, &mut channels, &schema_names, ch),
                     Record::Message { header, data } => {
                         let Some(sink) = sink.as_deref_mut() else {
                             // Peeking: the records before the first message are read.
                             break;
                         };
-                        let Some(channel) = channels.get(&header.channel_id) else {
-                            continue;
-                        };
-                        *log.message_counts.entry(channel.topic.clone()).or_insert(0) += 1;
-                        if !channel.json {
-                            if matches!(channel.kind, Topic::Skip | Topic::Foreign) {
-                                continue;
-                            }
-                            note_decode_error(
-                                &mut log,
-                                &channel.topic,
-                                "message encoding is not json".to_owned(),
-                            );
-                            continue;
-                        }
-                        let t_ns = i64::try_from(header.log_time).unwrap_or(i64::MAX);
-                        if let Some(msg) = decode_msg(&mut log, channel, t_ns, &data) {
-                            if t_ns < last_t_ns {
-                                log.decoded.out_of_order += 1;
-                            }
-                            last_t_ns = last_t_ns.max(t_ns);
-                            sink.put(t_ns, msg)?;
+                        if let Some(channel) = channels.get(&header.channel_id) {
+                            let t_ns = i64::try_from(header.log_time).unwrap_or(i64::MAX);
+                            put_message(&mut log, channel, t_ns, &data, sink, &mut last_t_ns)?;
                         }
                     }
                     Record::Metadata(m) if m.name == topics::METADATA_RUN => {
@@ -855,6 +785,122 @@ fn scan(
     }
     progress.set_position(bytes);
     Ok((log, channels))
+}
+
+/// Opens `path` for reading through a 1 MiB buffer that advances `progress` (its length
+/// set to the file's size); with the size, bytes.
+///
+/// # Errors
+/// The file cannot be opened or its size read, or it is empty.
+fn open_counted(
+    path: &Path,
+    progress: &indicatif::ProgressBar,
+) -> Result<(BufReader<Counting<File>>, u64)> {
+    let io_err = |source| AnalyzerError::Io {
+        path: path.to_owned(),
+        source,
+    };
+    let file = File::open(path).map_err(io_err)?;
+    let bytes = file.metadata().map_err(io_err)?.len();
+    if bytes == 0 {
+        return Err(AnalyzerError::Empty {
+            path: path.to_owned(),
+        });
+    }
+    progress.set_length(bytes);
+    progress.set_position(0);
+    let source = BufReader::with_capacity(
+        1 << 20,
+        Counting {
+            inner: file,
+            progress: progress.clone(),
+        },
+    );
+    Ok((source, bytes))
+}
+
+/// The [`LogFile`] of `path` (`bytes` long) before its first record is read.
+fn nothing_read(path: &Path, bytes: u64) -> LogFile {
+    LogFile {
+        path: path.to_owned(),
+        unit: Unit::Plant,
+        metadata: BTreeMap::new(),
+        scenario_text: None,
+        message_counts: BTreeMap::new(),
+        decode_errors: BTreeMap::new(),
+        truncated: None,
+        schema_mismatches: Vec::new(),
+        bytes,
+        plant: PlantData::default(),
+        controller: ControllerData::default(),
+        logs: Vec::new(),
+        decoded: Decoded::default(),
+    }
+}
+
+/// Registers the channel `ch`, noting in `log` a schema (named in `schema_names` by id)
+/// that differs from docs/logging.md.
+fn add_channel(
+    log: &mut LogFile,
+    channels: &mut BTreeMap<u16, ChannelInfo>,
+    schema_names: &BTreeMap<u16, String>,
+    ch: mcap::records::Channel,
+) {
+    let kind = classify(&ch.topic);
+    let json = ch.message_encoding == topics::MESSAGE_ENCODING;
+    if let (Some(expected), Some(found)) = (expected_schema(kind), schema_names.get(&ch.schema_id))
+    {
+        if expected != found {
+            log.schema_mismatches.push(format!(
+                "{}: schema `{found}`, docs/logging.md says `{expected}`",
+                ch.topic
+            ));
+        }
+    }
+    channels.insert(
+        ch.id,
+        ChannelInfo {
+            topic: ch.topic,
+            kind,
+            json,
+        },
+    );
+}
+
+/// Counts one message of `channel` (log time `t_ns`, payload `data`) and hands it decoded
+/// to `sink`; a message that is not JSON is noted as a decode error unless its topic is
+/// skipped or not in the contract. `last_t_ns`, the latest log time so far, tells the
+/// messages out of order.
+///
+/// # Errors
+/// The sink's.
+fn put_message(
+    log: &mut LogFile,
+    channel: &ChannelInfo,
+    t_ns: i64,
+    data: &[u8],
+    sink: &mut dyn Sink,
+    last_t_ns: &mut i64,
+) -> Result<()> {
+    *log.message_counts.entry(channel.topic.clone()).or_insert(0) += 1;
+    if !channel.json {
+        if !matches!(channel.kind, Topic::Skip | Topic::Foreign) {
+            note_decode_error(
+                log,
+                &channel.topic,
+                "message encoding is not json".to_owned(),
+            );
+        }
+        return Ok(());
+    }
+    if let Some(msg) = decode_msg(log, channel, t_ns, data) {
+        if t_ns < *last_t_ns {
+            log.decoded.out_of_order += 1;
+        }
+        *last_t_ns = (*last_t_ns).max(t_ns);
+        sink.put(t_ns, msg)?;
+    }
+    Ok(())
 }
 
 /// Turns the reader's error into "not MCAP" (nothing read yet) or a truncation mark.

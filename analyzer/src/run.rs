@@ -247,87 +247,26 @@ fn load(
         .map(|p| peek_log(p))
         .collect::<Result<Vec<Peek>>>()?;
     // The plant log: peeked as one (or as both units).
-    let mut plant: Option<usize> = None;
-    for (k, peek) in peeks.iter().enumerate() {
+    let peeked_plant = peeks.iter().enumerate().filter_map(|(k, peek)| {
         let is_plant = matches!(peek.unit, Some(Unit::Plant | Unit::Both))
             || plant_whole == Some(peek.path.as_path());
-        if is_plant {
-            if let Some(first) = plant {
-                return Err(AnalyzerError::DuplicateUnit {
-                    unit: "plant",
-                    first: paths[first].clone(),
-                    second: paths[k].clone(),
-                });
-            }
-            plant = Some(k);
-        }
-    }
-    // Every other log whole, keeping the controller's topics; a merged log too.
-    let mut logs: Vec<(usize, LogFile)> = Vec::new();
-    let mut empty = Vec::new();
-    for (k, path) in paths.iter().enumerate() {
-        let whole = plant != Some(k)
-            || peeks[k].unit == Some(Unit::Both)
-            || plant_whole == Some(path.as_path());
-        if !whole {
-            continue;
-        }
-        let bar = progress.add(crate::progress::bytes_bar(path));
-        let mut controller = ControllerData::default();
-        let log = read_into(path, &bar, &mut controller);
-        bar.finish_and_clear();
-        match log {
-            Ok(mut log) => {
-                log.controller = controller;
-                logs.push((k, log));
-            }
-            // A log cut before its first message: the others may still make a report.
-            Err(AnalyzerError::TruncatedEmpty { path, reason }) if plant != Some(k) => {
-                empty.push((path, reason));
-            }
-            Err(e) => return Err(e),
-        }
-    }
+        is_plant.then_some(k)
+    });
+    let plant = sole_log("plant", paths, None, peeked_plant)?;
+    let (logs, empty) = read_whole(paths, &peeks, plant, plant_whole, progress)?;
     // A log read whole may hold the plant's states where its first records did not say.
-    for (k, log) in &logs {
-        if log.has_plant() && plant != Some(*k) {
-            if let Some(first) = plant {
-                return Err(AnalyzerError::DuplicateUnit {
-                    unit: "plant",
-                    first: paths[first].clone(),
-                    second: paths[*k].clone(),
-                });
-            }
-            plant = Some(*k);
-        }
-    }
-    let Some(plant) = plant else {
-        if let Some((path, reason)) = empty.first() {
-            return Err(AnalyzerError::TruncatedEmpty {
-                path: path.clone(),
-                reason: reason.clone(),
-            });
-        }
-        let files = logs
-            .iter()
-            .map(|(_, l)| l.path.display().to_string())
-            .collect::<Vec<_>>()
-            .join(", ");
-        return Err(AnalyzerError::NoPlantLog { files });
+    let read_plant = logs
+        .iter()
+        .filter(|(k, log)| log.has_plant() && plant != Some(*k))
+        .map(|(k, _)| *k);
+    let Some(plant) = sole_log("plant", paths, plant, read_plant)? else {
+        return Err(no_plant_log(&logs, &empty));
     };
-    let mut controller_path: Option<usize> = None;
-    for (k, log) in &logs {
-        if log.has_controller() {
-            if let Some(first) = controller_path {
-                return Err(AnalyzerError::DuplicateUnit {
-                    unit: "controller",
-                    first: paths[first].clone(),
-                    second: paths[*k].clone(),
-                });
-            }
-            controller_path = Some(*k);
-        }
-    }
+    let read_controller = logs
+        .iter()
+        .filter(|(_, log)| log.has_controller())
+        .map(|(k, _)| *k);
+    let controller_path = sole_log("controller", paths, None, read_controller)?;
     let plant_read_whole = logs.iter().any(|(k, _)| *k == plant);
 
     // The scenario: the plant log's (as peeked, or read whole), else the controller's.
@@ -355,7 +294,128 @@ fn load(
         );
     }
 
-    // Files in the order given; the plant log's entry is replaced after its stream.
+    let (mut files, plant_file) = file_summaries(paths, &peeks, &logs, plant);
+    let (controller, unit_logs) = take_controller(logs, controller_path, plant);
+    let config = run_config(&scenario, scenario_source, params.as_ref(), &controller);
+    for (path, reason) in empty {
+        notes.push(format!(
+            "{} is truncated before any usable message and was left out",
+            path.display()
+        ));
+        files.push(left_out_summary(path, reason));
+    }
+    Ok(Run {
+        files,
+        plant_path: paths[plant].clone(),
+        plant_file,
+        controller,
+        logs: unit_logs,
+        config,
+        notes,
+        paths: paths.to_vec(),
+        plant_read_whole,
+        plant_scenario,
+        controller_path,
+    })
+}
+
+/// The one log (index into `paths`) of `unit`: `found` (already known, if any), else the
+/// first of `candidates` (indices into `paths`, in order).
+///
+/// # Errors
+/// [`AnalyzerError::DuplicateUnit`] naming the first two logs of the unit.
+fn sole_log(
+    unit: &'static str,
+    paths: &[PathBuf],
+    mut found: Option<usize>,
+    candidates: impl IntoIterator<Item = usize>,
+) -> Result<Option<usize>> {
+    for k in candidates {
+        if let Some(first) = found {
+            return Err(AnalyzerError::DuplicateUnit {
+                unit,
+                first: paths[first].clone(),
+                second: paths[k].clone(),
+            });
+        }
+        found = Some(k);
+    }
+    Ok(found)
+}
+
+/// Logs read whole, each with its index into the paths given.
+type ReadLogs = Vec<(usize, LogFile)>;
+
+/// Logs cut before their first message: the path and where it ends.
+type LeftOut = Vec<(PathBuf, String)>;
+
+/// Reads every log but the plant log (`plant`, as peeked) whole, keeping the controller's
+/// topics; the plant log too when it is a merged log or `plant_whole`. Also returns the
+/// other logs cut before their first message (path, reason): the others may still make a
+/// report.
+///
+/// # Errors
+/// A log that cannot be read (the plant log cut before its first message included).
+fn read_whole(
+    paths: &[PathBuf],
+    peeks: &[Peek],
+    plant: Option<usize>,
+    plant_whole: Option<&Path>,
+    progress: &indicatif::MultiProgress,
+) -> Result<(ReadLogs, LeftOut)> {
+    let mut logs: ReadLogs = Vec::new();
+    let mut empty = Vec::new();
+    for (k, path) in paths.iter().enumerate() {
+        let whole = plant != Some(k)
+            || peeks[k].unit == Some(Unit::Both)
+            || plant_whole == Some(path.as_path());
+        if !whole {
+            continue;
+        }
+        let bar = progress.add(crate::progress::bytes_bar(path));
+        let mut controller = ControllerData::default();
+        let log = read_into(path, &bar, &mut controller);
+        bar.finish_and_clear();
+        match log {
+            Ok(mut log) => {
+                log.controller = controller;
+                logs.push((k, log));
+            }
+            // A log cut before its first message: the others may still make a report.
+            Err(AnalyzerError::TruncatedEmpty { path, reason }) if plant != Some(k) => {
+                empty.push((path, reason));
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    Ok((logs, empty))
+}
+
+/// The error when no log holds the plant's states: the first log cut before its first
+/// message, else [`AnalyzerError::NoPlantLog`] listing the logs read.
+fn no_plant_log(logs: &[(usize, LogFile)], empty: &[(PathBuf, String)]) -> AnalyzerError {
+    if let Some((path, reason)) = empty.first() {
+        return AnalyzerError::TruncatedEmpty {
+            path: path.clone(),
+            reason: reason.clone(),
+        };
+    }
+    let files = logs
+        .iter()
+        .map(|(_, l)| l.path.display().to_string())
+        .collect::<Vec<_>>()
+        .join(", ");
+    AnalyzerError::NoPlantLog { files }
+}
+
+/// The files read, in the order given, and the index of the plant log's entry among them
+/// (from its peek; replaced after its stream).
+fn file_summaries(
+    paths: &[PathBuf],
+    peeks: &[Peek],
+    logs: &[(usize, LogFile)],
+    plant: usize,
+) -> (Vec<FileSummary>, usize) {
     let mut files = Vec::new();
     let mut plant_file = 0;
     for k in 0..paths.len() {
@@ -375,48 +435,41 @@ fn load(
             files.push(summarize(log));
         }
     }
+    (files, plant_file)
+}
+
+/// The controller log's topics (empty without one) and the unit logs of the logs read
+/// whole but the plant log (its unit logs come with its stream).
+fn take_controller(
+    logs: Vec<(usize, LogFile)>,
+    controller_path: Option<usize>,
+    plant: usize,
+) -> (ControllerData, Vec<LogLine>) {
     let mut controller = ControllerData::default();
     let mut unit_logs = Vec::new();
     for (k, log) in logs {
         if Some(k) == controller_path {
             controller = log.controller;
         }
-        // The plant log's unit logs come with its stream.
         if k != plant {
             unit_logs.extend(log.logs);
         }
     }
+    (controller, unit_logs)
+}
 
-    let config = run_config(&scenario, scenario_source, params.as_ref(), &controller);
-    for (path, reason) in empty {
-        notes.push(format!(
-            "{} is truncated before any usable message and was left out",
-            path.display()
-        ));
-        files.push(FileSummary {
-            path,
-            unit: "unknown (truncated)".to_owned(),
-            bytes: 0,
-            messages: std::collections::BTreeMap::new(),
-            decode_errors: std::collections::BTreeMap::new(),
-            schema_mismatches: Vec::new(),
-            truncated: Some(reason),
-            metadata: std::collections::BTreeMap::new(),
-        });
+/// The entry of a log left out because it is cut before its first message (`reason`).
+fn left_out_summary(path: PathBuf, reason: String) -> FileSummary {
+    FileSummary {
+        path,
+        unit: "unknown (truncated)".to_owned(),
+        bytes: 0,
+        messages: std::collections::BTreeMap::new(),
+        decode_errors: std::collections::BTreeMap::new(),
+        schema_mismatches: Vec::new(),
+        truncated: Some(reason),
+        metadata: std::collections::BTreeMap::new(),
     }
-    Ok(Run {
-        files,
-        plant_path: paths[plant].clone(),
-        plant_file,
-        controller,
-        logs: unit_logs,
-        config,
-        notes,
-        paths: paths.to_vec(),
-        plant_read_whole,
-        plant_scenario,
-        controller_path,
-    })
 }
 
 fn median_step_s(t_ns: &[i64]) -> Option<f64> {

@@ -260,16 +260,42 @@ impl SynthRun {
     ///
     /// # Errors
     /// The scenario text does not parse, or a log cannot be written.
-    #[allow(clippy::too_many_lines)]
     pub fn write(&self, plant_path: &Path, controller_path: &Path) -> Result<(), SynthError> {
         let text = self.scenario_toml();
         let scenario = Scenario::from_toml_str(&text, "synthetic run")
             .map_err(|e| SynthError(e.to_string()))?;
-        let ship_data = &scenario.ship_data;
-        let tug_data = &scenario.tug_data;
         let options = LogOptions::default();
         let mut plant = LogWriter::create(plant_path, options)?;
         let mut ctrl = LogWriter::create(controller_path, options)?;
+        self.write_run_info(&mut plant, &mut ctrl, &text)?;
+
+        let mut held: Vec<Option<Situation>> = vec![None; self.obstacles.len()];
+        for k in 0..=self.steps {
+            let tow = self.tow_at(&scenario, k);
+            let obstacles: Vec<ObstacleState> = (0..self.obstacles.len())
+                .filter_map(|j| self.obstacle_at(j, tow.t))
+                .collect();
+            self.write_plant_step(&mut plant, &scenario, &tow, &obstacles)?;
+            if self.scene {
+                write_scene(&mut plant, &scenario, &tow, &obstacles)?;
+            }
+            if k % self.steps_per_sample == 0 {
+                self.write_control_sample(&mut ctrl, &tow, &obstacles, &mut held)?;
+            }
+        }
+        plant.finish()?;
+        ctrl.finish()?;
+        Ok(())
+    }
+
+    /// Writes the `run` metadata (with the controller's parameters) and the scenario
+    /// `text` into both logs.
+    fn write_run_info(
+        &self,
+        plant: &mut LogWriter,
+        ctrl: &mut LogWriter,
+        text: &str,
+    ) -> Result<(), SynthError> {
         let params = serde_json::json!({
             "architecture": self.architecture,
             "avoidance_scheme": self.scheme,
@@ -284,7 +310,7 @@ impl SynthRun {
             "detection_distance": 7.0,
             "safety_buffer": 0.25,
         });
-        for (w, unit) in [(&mut plant, "TowingPlant"), (&mut ctrl, "TowingController")] {
+        for (w, unit) in [(plant, "TowingPlant"), (ctrl, "TowingController")] {
             w.write_run(&RunInfo {
                 unit,
                 guid: "{00000000-0000-0000-0000-000000000000}",
@@ -293,260 +319,349 @@ impl SynthRun {
                 scenario_name: &self.name,
                 start_time: 0.0,
                 parameters: params.clone(),
-                scenario_text: &text,
+                scenario_text: text,
             })?;
         }
-
-        let l_tow = scenario.towline_desired_length;
-        let mut held: Vec<Option<Situation>> = vec![None; self.obstacles.len()];
-        for k in 0..=self.steps {
-            let t = k as f64 * self.dt;
-            let [sx, sy, sp, su] = self.ship_at(t);
-            let lengths = [0, 1]
-                .map(|i| l_tow[i] * (1.0 + self.elongation[i] * (2.0 * PI * t / 100.0).sin()));
-            // Formation with towing angle 0: tug 2 ahead of the bow point, tug 1 behind
-            // the stern point, both on the ship's heading.
-            let bow = body_to_ned(sx, sy, sp, ship_data.bow_tow_point_x, 0.0);
-            let stern = body_to_ned(sx, sy, sp, ship_data.stern_tow_point_x, 0.0);
-            let t2 = body_to_ned(
-                bow[0],
-                bow[1],
-                sp,
-                lengths[1] - tug_data[1].stern_tow_point_x,
-                0.0,
-            );
-            let t1 = body_to_ned(
-                stern[0],
-                stern[1],
-                sp,
-                -(lengths[0] + tug_data[0].bow_tow_point_x),
-                0.0,
-            );
-            let vs = |x: f64, y: f64| VesselState {
-                t,
-                x,
-                y,
-                psi: sp,
-                u: su,
-                v: 0.0,
-                r: 0.0,
-            };
-            plant.write(names::PLANT_SHIP, t, &vs(sx, sy))?;
-            plant.write(names::PLANT_TUG1, t, &vs(t1[0], t1[1]))?;
-            plant.write(names::PLANT_TUG2, t, &vs(t2[0], t2[1]))?;
-            let sample = k / self.steps_per_sample;
-            let tension = |i: usize| {
-                let base = 1.0 + 0.2 * ((2.0 * PI * sample as f64 / 200.0) + i as f64).sin();
-                if self.tension_spike_at_sample == Some(sample) {
-                    3.5
-                } else {
-                    base
-                }
-            };
-            let angle =
-                |i: usize| 10f64.to_radians() * (2.0 * PI * sample as f64 / 300.0 + i as f64).sin();
-            for i in 0..2 {
-                plant.write(
-                    if i == 0 {
-                        names::PLANT_TOWLINE1
-                    } else {
-                        names::PLANT_TOWLINE2
-                    },
-                    t,
-                    &TowlineState {
-                        t,
-                        length: lengths[i],
-                        angle: 0.0,
-                        tension: tension(i),
-                        tension_cmd: tension(i),
-                        slack: false,
-                        elongation_error: (lengths[i] - l_tow[i]) / l_tow[i],
-                    },
-                )?;
-            }
-            let obstacles: Vec<ObstacleState> = (0..self.obstacles.len())
-                .filter_map(|j| self.obstacle_at(j, t))
-                .collect();
-            plant.write(
-                names::PLANT_OBSTACLES,
-                t,
-                &Obstacles {
-                    t,
-                    obstacles: obstacles.clone(),
-                },
-            )?;
-            let thrust = [2.0, 0.1 * (t / 50.0).sin(), 0.05];
-            plant.write(
-                names::PLANT_INPUTS,
-                t,
-                &PlantInputs {
-                    t,
-                    tug1: thrust,
-                    tug2: thrust,
-                    tension_cmd: [tension(0), tension(1)],
-                },
-            )?;
-            if self.scene {
-                let poses = [(sx, sy), (t1[0], t1[1]), (t2[0], t2[1])];
-                plant.write(
-                    names::TF,
-                    t,
-                    &FrameTransforms {
-                        transforms: ["ship", "tug1", "tug2"]
-                            .iter()
-                            .zip(poses)
-                            .map(|(n, (x, y))| scene::frame_transform(n, t, x, y, sp))
-                            .collect(),
-                    },
-                )?;
-                let mut e = SceneEntity::new("vessels", t);
-                e.cubes.push(scene::hull_cube(
-                    sx,
-                    sy,
-                    sp,
-                    ship_data.length,
-                    ship_data.width,
-                    colors::SHIP,
-                ));
-                e.cubes
-                    .push(scene::hull_cube(t1[0], t1[1], sp, 0.97, 0.3, colors::TUG));
-                e.cubes
-                    .push(scene::hull_cube(t2[0], t2[1], sp, 0.97, 0.3, colors::TUG));
-                e.lines
-                    .push(scene::line_strip([stern, t1], 0.1, 0.02, colors::TOWLINE));
-                e.lines
-                    .push(scene::line_strip([bow, t2], 0.1, 0.02, colors::TOWLINE));
-                let mut o = SceneEntity::new("targets", t);
-                for ob in obstacles.iter().filter(|o| o.kind == 2) {
-                    o.cylinders.push(scene::cylinder(
-                        ob.x,
-                        ob.y,
-                        ob.psi,
-                        ob.length,
-                        ob.width,
-                        0.2,
-                        colors::TARGET,
-                    ));
-                }
-                plant.write(
-                    names::PLANT_SCENE,
-                    t,
-                    &SceneUpdate {
-                        deletions: Vec::new(),
-                        entities: vec![e, o],
-                    },
-                )?;
-            }
-
-            if k % self.steps_per_sample == 0 {
-                let s = sample;
-                let next = self
-                    .route
-                    .iter()
-                    .skip(1)
-                    .find(|p| (p[0] - sx).hypot(p[1] - sy) > 0.6)
-                    .copied()
-                    .unwrap_or(self.route[self.route.len() - 1]);
-                ctrl.write(
-                    names::CONTROLLER_REFERENCE,
-                    t,
-                    &Reference {
-                        t,
-                        x: next[0],
-                        y: next[1],
-                        psi: next[2].to_radians(),
-                        active_waypoint: 1,
-                        altered: false,
-                        d_ob: 1e6,
-                        waypoint: [next[0], next[1], next[2].to_radians()],
-                    },
-                )?;
-                let mut targets = Vec::new();
-                for ob in &obstacles {
-                    let j = (ob.slot - 1) as usize;
-                    let (code, role) = if ob.kind == 1 {
-                        (-1, "none")
-                    } else {
-                        let range = (ob.x - sx).hypot(ob.y - sy);
-                        if held[j].is_none() && range < 7.0 {
-                            let beta = relative_bearing([sx, sy], sp, [ob.x, ob.y]).to_degrees();
-                            let alpha =
-                                relative_bearing([ob.x, ob.y], ob.psi, [sx, sy]).to_degrees();
-                            held[j] = Some(classify(beta, alpha, su, ob.speed));
-                        }
-                        match held[j] {
-                            Some(Situation::CrossingStandOn | Situation::BeingOvertaken) => {
-                                (situation_code(held[j]), "stand-on")
-                            }
-                            Some(_) => (situation_code(held[j]), "give-way"),
-                            None => (0, "none"),
-                        }
-                    };
-                    targets.push(Encounter {
-                        slot: ob.slot,
-                        situation: Situation::from_code(code)
-                            .map_or("none", Situation::name)
-                            .to_owned(),
-                        role: role.to_owned(),
-                        situation_code: code,
-                        role_code: match role {
-                            "give-way" => 1,
-                            "stand-on" => 2,
-                            _ => 0,
-                        },
-                    });
-                }
-                ctrl.write(names::CONTROLLER_COLREGS, t, &Colregs { t, targets })?;
-                ctrl.write(
-                    names::CONTROLLER_COMMAND,
-                    t,
-                    &Command {
-                        t,
-                        tug1: thrust,
-                        tug2: thrust,
-                        tension: [tension(0), tension(1)],
-                        desired_angle: [angle(0), angle(1)],
-                    },
-                )?;
-                let iterations = 10 + u32::try_from(s * 5 % 21).unwrap_or(0);
-                let fallback =
-                    (s > 0 && s.is_multiple_of(500)).then(|| "synthetic fallback".to_owned());
-                ctrl.write(
-                    names::CONTROLLER_SOLVER,
-                    t,
-                    &Solver {
-                        t,
-                        architecture: self.architecture,
-                        scheme: self.scheme,
-                        iterations,
-                        converged: iterations < 30,
-                        r_pri: [1e-3 * (1.0 + (s % 5) as f64), 2e-3],
-                        r_dual: [5e-4, 1e-4 * (1.0 + (s % 3) as f64)],
-                        compute_time_ms: 5.0 + (s * 13 % 40) as f64 + 0.5,
-                        samples: s as u64 + 1,
-                        fallbacks: (s / 500) as u64,
-                        fallback,
-                    },
-                )?;
-                if self.scene {
-                    let pose = |x: f64, y: f64| vec![[x, y, sp]; 3];
-                    ctrl.write(
-                        names::CONTROLLER_PREDICTION,
-                        t,
-                        &Prediction {
-                            t,
-                            ship: pose(sx, sy),
-                            tug1: pose(t1[0], t1[1]),
-                            tug2: pose(t2[0], t2[1]),
-                        },
-                    )?;
-                }
-            }
-        }
-        plant.finish()?;
-        ctrl.finish()?;
         Ok(())
     }
+
+    /// The tow at plant step `k`: the ship on the route, the towlines at their oscillating
+    /// lengths and the tugs in formation with towing angle 0 (tug 2 ahead of the bow
+    /// point, tug 1 behind the stern point, both on the ship's heading).
+    fn tow_at(&self, scenario: &Scenario, k: usize) -> TowAt {
+        let t = k as f64 * self.dt;
+        let ship = self.ship_at(t);
+        let [sx, sy, sp, _] = ship;
+        let l_tow = scenario.towline_desired_length;
+        let lengths =
+            [0, 1].map(|i| l_tow[i] * (1.0 + self.elongation[i] * (2.0 * PI * t / 100.0).sin()));
+        let ship_data = &scenario.ship_data;
+        let tug_data = &scenario.tug_data;
+        let bow = body_to_ned(sx, sy, sp, ship_data.bow_tow_point_x, 0.0);
+        let stern = body_to_ned(sx, sy, sp, ship_data.stern_tow_point_x, 0.0);
+        let tug2 = body_to_ned(
+            bow[0],
+            bow[1],
+            sp,
+            lengths[1] - tug_data[1].stern_tow_point_x,
+            0.0,
+        );
+        let tug1 = body_to_ned(
+            stern[0],
+            stern[1],
+            sp,
+            -(lengths[0] + tug_data[0].bow_tow_point_x),
+            0.0,
+        );
+        TowAt {
+            t,
+            ship,
+            tug1,
+            tug2,
+            bow,
+            stern,
+            lengths,
+            sample: k / self.steps_per_sample,
+        }
+    }
+
+    /// Commanded (and measured) tension of towline `i` at control sample `sample`, N: a
+    /// slow sine, or the spike of `tension_spike_at_sample`.
+    fn tension(&self, sample: usize, i: usize) -> f64 {
+        let base = 1.0 + 0.2 * ((2.0 * PI * sample as f64 / 200.0) + i as f64).sin();
+        if self.tension_spike_at_sample == Some(sample) {
+            3.5
+        } else {
+            base
+        }
+    }
+
+    /// Writes the plant's topics of one step: the vessels, the towlines, the obstacles
+    /// and the inputs.
+    fn write_plant_step(
+        &self,
+        plant: &mut LogWriter,
+        scenario: &Scenario,
+        tow: &TowAt,
+        obstacles: &[ObstacleState],
+    ) -> Result<(), SynthError> {
+        let t = tow.t;
+        let [sx, sy, sp, su] = tow.ship;
+        let vs = |x: f64, y: f64| VesselState {
+            t,
+            x,
+            y,
+            psi: sp,
+            u: su,
+            v: 0.0,
+            r: 0.0,
+        };
+        plant.write(names::PLANT_SHIP, t, &vs(sx, sy))?;
+        plant.write(names::PLANT_TUG1, t, &vs(tow.tug1[0], tow.tug1[1]))?;
+        plant.write(names::PLANT_TUG2, t, &vs(tow.tug2[0], tow.tug2[1]))?;
+        let l_tow = scenario.towline_desired_length;
+        let lengths = tow.lengths;
+        for i in 0..2 {
+            plant.write(
+                if i == 0 {
+                    names::PLANT_TOWLINE1
+                } else {
+                    names::PLANT_TOWLINE2
+                },
+                t,
+                &TowlineState {
+                    t,
+                    length: lengths[i],
+                    angle: 0.0,
+                    tension: self.tension(tow.sample, i),
+                    tension_cmd: self.tension(tow.sample, i),
+                    slack: false,
+                    elongation_error: (lengths[i] - l_tow[i]) / l_tow[i],
+                },
+            )?;
+        }
+        plant.write(
+            names::PLANT_OBSTACLES,
+            t,
+            &Obstacles {
+                t,
+                obstacles: obstacles.to_vec(),
+            },
+        )?;
+        plant.write(
+            names::PLANT_INPUTS,
+            t,
+            &PlantInputs {
+                t,
+                tug1: thrust(t),
+                tug2: thrust(t),
+                tension_cmd: [self.tension(tow.sample, 0), self.tension(tow.sample, 1)],
+            },
+        )?;
+        Ok(())
+    }
+
+    /// Writes the controller's topics of one control sample: the reference (the next
+    /// route point farther than 0.6 m), the COLREGS situations ([`Self::encounters`]), the
+    /// command, the solver report and (with `scene`) the prediction.
+    fn write_control_sample(
+        &self,
+        ctrl: &mut LogWriter,
+        tow: &TowAt,
+        obstacles: &[ObstacleState],
+        held: &mut [Option<Situation>],
+    ) -> Result<(), SynthError> {
+        let t = tow.t;
+        let s = tow.sample;
+        let [sx, sy, sp, _] = tow.ship;
+        let next = self
+            .route
+            .iter()
+            .skip(1)
+            .find(|p| (p[0] - sx).hypot(p[1] - sy) > 0.6)
+            .copied()
+            .unwrap_or(self.route[self.route.len() - 1]);
+        ctrl.write(
+            names::CONTROLLER_REFERENCE,
+            t,
+            &Reference {
+                t,
+                x: next[0],
+                y: next[1],
+                psi: next[2].to_radians(),
+                active_waypoint: 1,
+                altered: false,
+                d_ob: 1e6,
+                waypoint: [next[0], next[1], next[2].to_radians()],
+            },
+        )?;
+        let targets = encounters(tow, obstacles, held);
+        ctrl.write(names::CONTROLLER_COLREGS, t, &Colregs { t, targets })?;
+        let angle = |i: usize| 10f64.to_radians() * (2.0 * PI * s as f64 / 300.0 + i as f64).sin();
+        ctrl.write(
+            names::CONTROLLER_COMMAND,
+            t,
+            &Command {
+                t,
+                tug1: thrust(t),
+                tug2: thrust(t),
+                tension: [self.tension(s, 0), self.tension(s, 1)],
+                desired_angle: [angle(0), angle(1)],
+            },
+        )?;
+        let iterations = 10 + u32::try_from(s * 5 % 21).unwrap_or(0);
+        let fallback = (s > 0 && s.is_multiple_of(500)).then(|| "synthetic fallback".to_owned());
+        ctrl.write(
+            names::CONTROLLER_SOLVER,
+            t,
+            &Solver {
+                t,
+                architecture: self.architecture,
+                scheme: self.scheme,
+                iterations,
+                converged: iterations < 30,
+                r_pri: [1e-3 * (1.0 + (s % 5) as f64), 2e-3],
+                r_dual: [5e-4, 1e-4 * (1.0 + (s % 3) as f64)],
+                compute_time_ms: 5.0 + (s * 13 % 40) as f64 + 0.5,
+                samples: s as u64 + 1,
+                fallbacks: (s / 500) as u64,
+                fallback,
+            },
+        )?;
+        if self.scene {
+            let pose = |x: f64, y: f64| vec![[x, y, sp]; 3];
+            ctrl.write(
+                names::CONTROLLER_PREDICTION,
+                t,
+                &Prediction {
+                    t,
+                    ship: pose(sx, sy),
+                    tug1: pose(tow.tug1[0], tow.tug1[1]),
+                    tug2: pose(tow.tug2[0], tow.tug2[1]),
+                },
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// The tow at one plant step of a synthetic run.
+struct TowAt {
+    /// Time, s.
+    t: f64,
+    /// Ship North, East (m), heading (rad), surge (m/s).
+    ship: [f64; 4],
+    /// Tug 1 (aft) North, East, m.
+    tug1: [f64; 2],
+    /// Tug 2 (forward) North, East, m.
+    tug2: [f64; 2],
+    /// The ship's bow tow point, North, East, m.
+    bow: [f64; 2],
+    /// The ship's stern tow point, North, East, m.
+    stern: [f64; 2],
+    /// Towline 1 and 2 lengths, m.
+    lengths: [f64; 2],
+    /// Control sample the step belongs to.
+    sample: usize,
+}
+
+/// Thrust of each tug (X N, Y N, N N m) at time `t`, s: commanded and applied alike.
+fn thrust(t: f64) -> [f64; 3] {
+    [2.0, 0.1 * (t / 50.0).sin(), 0.05]
+}
+
+/// Writes the scene topics of one plant step: `/tf` and the hulls, towlines and target
+/// ships.
+fn write_scene(
+    plant: &mut LogWriter,
+    scenario: &Scenario,
+    tow: &TowAt,
+    obstacles: &[ObstacleState],
+) -> Result<(), SynthError> {
+    let t = tow.t;
+    let [sx, sy, sp, _] = tow.ship;
+    let (t1, t2) = (tow.tug1, tow.tug2);
+    let poses = [(sx, sy), (t1[0], t1[1]), (t2[0], t2[1])];
+    plant.write(
+        names::TF,
+        t,
+        &FrameTransforms {
+            transforms: ["ship", "tug1", "tug2"]
+                .iter()
+                .zip(poses)
+                .map(|(n, (x, y))| scene::frame_transform(n, t, x, y, sp))
+                .collect(),
+        },
+    )?;
+    let ship_data = &scenario.ship_data;
+    let mut e = SceneEntity::new("vessels", t);
+    e.cubes.push(scene::hull_cube(
+        sx,
+        sy,
+        sp,
+        ship_data.length,
+        ship_data.width,
+        colors::SHIP,
+    ));
+    e.cubes
+        .push(scene::hull_cube(t1[0], t1[1], sp, 0.97, 0.3, colors::TUG));
+    e.cubes
+        .push(scene::hull_cube(t2[0], t2[1], sp, 0.97, 0.3, colors::TUG));
+    e.lines.push(scene::line_strip(
+        [tow.stern, t1],
+        0.1,
+        0.02,
+        colors::TOWLINE,
+    ));
+    e.lines
+        .push(scene::line_strip([tow.bow, t2], 0.1, 0.02, colors::TOWLINE));
+    let mut o = SceneEntity::new("targets", t);
+    for ob in obstacles.iter().filter(|o| o.kind == 2) {
+        o.cylinders.push(scene::cylinder(
+            ob.x,
+            ob.y,
+            ob.psi,
+            ob.length,
+            ob.width,
+            0.2,
+            colors::TARGET,
+        ));
+    }
+    plant.write(
+        names::PLANT_SCENE,
+        t,
+        &SceneUpdate {
+            deletions: Vec::new(),
+            entities: vec![e, o],
+        },
+    )?;
+    Ok(())
+}
+
+/// The situation and role of each active obstacle: static ones none; a target ship's is
+/// classified once, when it first comes within 7 m (the detection distance), and held in
+/// `held` (by slot) afterwards.
+fn encounters(
+    tow: &TowAt,
+    obstacles: &[ObstacleState],
+    held: &mut [Option<Situation>],
+) -> Vec<Encounter> {
+    let [sx, sy, sp, su] = tow.ship;
+    let mut targets = Vec::new();
+    for ob in obstacles {
+        let j = (ob.slot - 1) as usize;
+        let (code, role) = if ob.kind == 1 {
+            (-1, "none")
+        } else {
+            let range = (ob.x - sx).hypot(ob.y - sy);
+            if held[j].is_none() && range < 7.0 {
+                let beta = relative_bearing([sx, sy], sp, [ob.x, ob.y]).to_degrees();
+                let alpha = relative_bearing([ob.x, ob.y], ob.psi, [sx, sy]).to_degrees();
+                held[j] = Some(classify(beta, alpha, su, ob.speed));
+            }
+            match held[j] {
+                Some(Situation::CrossingStandOn | Situation::BeingOvertaken) => {
+                    (situation_code(held[j]), "stand-on")
+                }
+                Some(_) => (situation_code(held[j]), "give-way"),
+                None => (0, "none"),
+            }
+        };
+        targets.push(Encounter {
+            slot: ob.slot,
+            situation: Situation::from_code(code)
+                .map_or("none", Situation::name)
+                .to_owned(),
+            role: role.to_owned(),
+            situation_code: code,
+            role_code: match role {
+                "give-way" => 1,
+                "stand-on" => 2,
+                _ => 0,
+            },
+        });
+    }
+    targets
 }
 
 fn situation_code(s: Option<Situation>) -> i32 {
