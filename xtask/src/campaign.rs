@@ -5,7 +5,8 @@
 //! environment with Dask) and hands over to `masters/campaign.py`, which holds the campaign
 //! logic: Dask, the task that travels to the workers and the fmpy master all live in Python.
 
-use crate::{cargo, fail, fmu, python, run, target_dir, Result};
+use crate::runs::Tools;
+use crate::{fail, run, Result};
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -68,32 +69,18 @@ pub fn campaign(args: &[String]) -> Result<()> {
     // the repository root).
     let cwd =
         std::env::current_dir().or_else(|e| fail(STEP, format!("no current directory: {e}")))?;
-    let fmus = fmu::package_all()?;
-    let find = |model: &str| {
-        fmus.iter()
-            .find(|p| p.file_stem().is_some_and(|n| n == model))
-            .cloned()
-            .map_or_else(|| fail(STEP, format!("{model}.fmu was not packaged")), Ok)
-    };
-    let plant = find("TowingPlant")?;
-    let controller = find("TowingController")?;
-    run(
-        "build the analyzer",
-        cargo().args(["build", "--release", "--package", "analyzer"]),
-    )?;
-    let analyzer = target_dir().join("release/analyzer");
-    let python = python::ensure_env()?;
-    let mut cmd = Command::new(python);
+    let tools = Tools::prepare()?;
+    let mut cmd = Command::new(&tools.python);
     cmd.arg("masters/campaign.py")
         .arg(cwd.join(&options.file))
         .arg("--out")
         .arg(cwd.join(&options.out))
         .arg("--plant")
-        .arg(plant)
+        .arg(&tools.plant)
         .arg("--controller")
-        .arg(controller)
+        .arg(&tools.controller)
         .arg("--analyzer")
-        .arg(analyzer);
+        .arg(&tools.analyzer);
     if let Some(n) = &options.workers {
         cmd.args(["--workers", n]);
     }

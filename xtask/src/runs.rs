@@ -63,18 +63,23 @@ const PAPER_CASES: [Case; 6] = [
 /// Simulated time of every run, s: the paper's runs settle by about 1150 s.
 const STOP_TIME: &str = "1200";
 
-/// What every run needs: the Python environment, the packaged FMUs, the analyzer binary.
-struct Tools {
-    python: PathBuf,
-    plant: PathBuf,
-    controller: PathBuf,
-    analyzer: PathBuf,
+/// What every run needs: the Python environment, the packaged FMUs, the analyzer binary
+/// (the paper's runs here, the campaigns in `campaign.rs`).
+pub struct Tools {
+    /// The venv's Python.
+    pub python: PathBuf,
+    /// `TowingPlant.fmu`.
+    pub plant: PathBuf,
+    /// `TowingController.fmu`.
+    pub controller: PathBuf,
+    /// The release `analyzer` binary.
+    pub analyzer: PathBuf,
 }
 
 impl Tools {
     /// Prepares all of them (a second call reuses what exists: the venv's stamp, cargo's
     /// incremental build).
-    fn prepare() -> Result<Self> {
+    pub fn prepare() -> Result<Self> {
         let python = python::ensure_env()?;
         let fmus = fmu::package_all()?;
         let find = |model: &str| {
