@@ -30,8 +30,8 @@ use towing_guidance::{
 };
 use towing_model::{wrap_angle, VesselData, VesselState, World, MAX_OBSTACLES};
 use towing_mpc::{
-    Admm, AppliedCommand, Centralized, Obstacle, QpOutcome, SampleInput, ShipInput, ShipModel,
-    ShipState, TugInput, TugState, HORIZON,
+    Admm, AppliedCommand, Budget, Centralized, Obstacle, Optimizer, QpOutcome, SampleInput,
+    ShipInput, ShipModel, TugInput, HORIZON,
 };
 
 use crate::config::{Architecture, ControllerConfig, InnerLoopParams};
@@ -190,7 +190,7 @@ impl std::fmt::Display for Fallback {
 pub struct Controller {
     config: ControllerConfig,
     guidance: ReferenceSystem,
-    solver: Solver,
+    solver: Box<dyn Optimizer>,
     inner_k: [[[f64; 3]; 3]; 2],
     thrust_limit: [[f64; 3]; 2],
     applied: AppliedCommand,
@@ -239,22 +239,7 @@ impl Controller {
             ship_params.weights[2] = 0.0;
             tug_params.weights[2] = 0.0;
         }
-        let solver = match config.architecture {
-            Architecture::Distributed => {
-                Solver::Distributed(Box::new(build_admm(&config, ship_params, tug_params)?))
-            }
-            Architecture::Centralized => Solver::Centralized(Box::new(
-                Centralized::from_scenario(
-                    &config.scenario,
-                    config.hull,
-                    config.prediction,
-                    ship_params,
-                    tug_params,
-                    config.centralized,
-                )
-                .map_err(|e| ConfigError::new("centralized MPC", format!("{e:?}")))?,
-            )),
-        };
+        let solver = build_optimizer(&config, ship_params, tug_params)?;
         let s = &config.scenario;
         let inner_k = std::array::from_fn(|i| {
             let m = mass_matrix(&s.tug_data[i]);
@@ -375,9 +360,9 @@ impl Controller {
             obstacles: &self.mpc_obstacles[..n_obstacles],
             heading_floor,
         };
-        let report = self.solver.solve(&input);
-        let ship_plan = *self.solver.ship_plan();
-        let tug_plans = [*self.solver.tug_plan(0), *self.solver.tug_plan(1)];
+        let report = self.solver.solve(&input, Budget::unlimited());
+        let ship_plan = self.solver.ship_plan();
+        let tug_plans = [self.solver.tug_plan(0), self.solver.tug_plan(1)];
         let finite = ship_plan.iter().flatten().all(|v| v.is_finite())
             && tug_plans.iter().flatten().flatten().all(|v| v.is_finite());
         let fallback = if let Some((problem, outcome)) = report.failed {
@@ -707,116 +692,34 @@ fn mpc_obstacle(o: &ObstacleInput, sample_time: f64) -> Obstacle {
     }
 }
 
-/// Common report of either architecture.
-struct SolveReport {
-    iterations: usize,
-    converged: bool,
-    /// The first subproblem whose last QP solve failed, and how.
-    failed: Option<(&'static str, QpOutcome)>,
-    r_pri: [f64; 2],
-    r_dual: [f64; 2],
-}
-
-/// The distributed or the centralized MPC.
-#[derive(Debug)]
-enum Solver {
-    Distributed(Box<Admm>),
-    Centralized(Box<Centralized>),
-}
-
-impl Solver {
-    fn solve(&mut self, input: &SampleInput<'_>) -> SolveReport {
-        match self {
-            Solver::Distributed(a) => {
-                let r = a.solve_sample(input);
-                SolveReport {
-                    iterations: r.iterations,
-                    converged: r.converged,
-                    failed: ["tug 1", "tug 2", "ship"]
-                        .into_iter()
-                        .zip(r.last_steps)
-                        .find(|(_, s)| !s.qp.is_usable())
-                        .map(|(name, s)| (name, s.qp)),
-                    r_pri: r.r_pri,
-                    r_dual: r.r_dual,
-                }
-            }
-            Solver::Centralized(c) => {
-                let r = c.solve_sample(input);
-                SolveReport {
-                    iterations: r.iterations,
-                    converged: r.converged,
-                    failed: r.failed.then_some(("centralized", r.last_step.qp)),
-                    // The consensus violation plays the primal residual's part.
-                    r_pri: [r.breakdown.consensus_max; 2],
-                    r_dual: [0.0; 2],
-                }
-            }
-        }
-    }
-
-    fn ship_plan(&self) -> &[ShipInput; HORIZON] {
-        match self {
-            Solver::Distributed(a) => a.ship().plan(),
-            Solver::Centralized(c) => c.ship_plan(),
-        }
-    }
-
-    fn tug_plan(&self, i: usize) -> &[TugInput; HORIZON] {
-        match self {
-            Solver::Distributed(a) => a.tug(i).plan(),
-            Solver::Centralized(c) => c.tug_plan(i),
-        }
-    }
-
-    fn ship_predicted(&self) -> &[ShipState; HORIZON] {
-        match self {
-            Solver::Distributed(a) => a.ship().predicted_states(),
-            Solver::Centralized(c) => c.ship_predicted(),
-        }
-    }
-
-    fn tug_predicted(&self, i: usize) -> &[TugState; HORIZON] {
-        match self {
-            Solver::Distributed(a) => a.tug(i).predicted_states(),
-            Solver::Centralized(c) => c.tug_predicted(i),
-        }
-    }
-
-    fn ship_model(&self) -> &ShipModel {
-        match self {
-            Solver::Distributed(a) => a.ship().model(),
-            Solver::Centralized(c) => c.ship_model(),
-        }
-    }
-
-    fn reset(&mut self) {
-        match self {
-            Solver::Distributed(a) => a.reset(),
-            Solver::Centralized(c) => c.reset(),
-        }
-    }
-
-    fn shift(&mut self) {
-        match self {
-            Solver::Distributed(a) => a.shift(),
-            Solver::Centralized(c) => c.shift(),
-        }
-    }
-}
-
-fn build_admm(
+/// The optimizer of the configured architecture.
+fn build_optimizer(
     config: &ControllerConfig,
     ship_params: towing_mpc::ShipMpcParams,
     tug_params: towing_mpc::TugMpcParams,
-) -> Result<Admm, ConfigError> {
-    Admm::from_scenario_with(
-        &config.scenario,
-        config.hull,
-        config.prediction,
-        ship_params,
-        tug_params,
-        config.admm,
-    )
-    .map_err(|e| ConfigError::new("distributed MPC", format!("{e:?}")))
+) -> Result<Box<dyn Optimizer>, ConfigError> {
+    Ok(match config.architecture {
+        Architecture::Distributed => Box::new(
+            Admm::from_scenario_with(
+                &config.scenario,
+                config.hull,
+                config.prediction,
+                ship_params,
+                tug_params,
+                config.admm,
+            )
+            .map_err(|e| ConfigError::new("distributed MPC", format!("{e:?}")))?,
+        ),
+        Architecture::Centralized => Box::new(
+            Centralized::from_scenario(
+                &config.scenario,
+                config.hull,
+                config.prediction,
+                ship_params,
+                tug_params,
+                config.centralized,
+            )
+            .map_err(|e| ConfigError::new("centralized MPC", format!("{e:?}")))?,
+        ),
+    })
 }

@@ -42,9 +42,9 @@ fn bench(c: &mut Criterion) {
     let tug_plan = [[1.0, 0.0, 0.0]; HORIZON];
     c.bench_function("tug_scp_step", |b| {
         b.iter(|| {
-            tug.set_plan(tug_plan);
+            tug.set_inputs(tug_plan);
             tug.trust_region_mut().reset();
-            black_box(tug.solve_step(black_box(&tug_data)))
+            black_box(tug.step(black_box(&tug_data)))
         })
     });
     // The same without clearance rows (distance cost only): the price of the rows.
@@ -54,9 +54,9 @@ fn bench(c: &mut Criterion) {
     let mut tug = TugMpc::new(tug_model, no_rows).expect("tug QP");
     c.bench_function("tug_scp_step_no_clearance_rows", |b| {
         b.iter(|| {
-            tug.set_plan(tug_plan);
+            tug.set_inputs(tug_plan);
             tug.trust_region_mut().reset();
-            black_box(tug.solve_step(black_box(&tug_data)))
+            black_box(tug.step(black_box(&tug_data)))
         })
     });
 
@@ -79,9 +79,9 @@ fn bench(c: &mut Criterion) {
     let ship_plan = [[0.5, 1.0, 0.0, 0.0]; HORIZON];
     c.bench_function("ship_scp_step", |b| {
         b.iter(|| {
-            ship.set_plan(ship_plan);
+            ship.set_inputs(ship_plan);
             ship.trust_region_mut().reset();
-            black_box(ship.solve_step(black_box(&ship_data)))
+            black_box(ship.step(black_box(&ship_data)))
         })
     });
     let mut no_rows = ShipMpcParams::default();
@@ -90,9 +90,9 @@ fn bench(c: &mut Criterion) {
     let mut ship = ShipMpc::new(ship_model, formation, no_rows).expect("ship QP");
     c.bench_function("ship_scp_step_no_clearance_rows", |b| {
         b.iter(|| {
-            ship.set_plan(ship_plan);
+            ship.set_inputs(ship_plan);
             ship.trust_region_mut().reset();
-            black_box(ship.solve_step(black_box(&ship_data)))
+            black_box(ship.step(black_box(&ship_data)))
         })
     });
 }

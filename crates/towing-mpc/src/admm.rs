@@ -3,13 +3,13 @@
 //!
 //! Per iteration `s = 1..S`:
 //!
-//! 1. each tug takes one SCP step of (25) ([`TugMpc::solve_step`]) given
+//! 1. each tug takes one SCP step of (25) ([`TugMpc`]`::step`) given
 //!    `f_i(tau_S^{s-1})`: the tug references of the configuration map
 //!    ([`FormationMap`]) along the ship's current predicted trajectory and towing
 //!    angles, the towline pulls of the ship's current plan (tension `F_ih`, bearing
 //!    `psi_S + alpha_ih` with `psi_S` the ship's heading at the start of sample `h`,
 //!    [`TowlinePull::from_plan`]) and `lambda^{s-1}`;
-//! 2. the ship takes one SCP step of (26) ([`ShipMpc::solve_step`]) given
+//! 2. the ship takes one SCP step of (26) ([`ShipMpc`]`::step`) given
 //!    `g_i(tau_Ti^s)`, the tugs' predicted poses, and `lambda^{s-1}`;
 //! 3. `lambda_i += rho (g_i - f_i)` (27), with `f_i = f_i(tau_S^s)`;
 //! 4. residuals `r_pri,i = |g_i - f_i|_2`, `r_dual,i = |f_i^s - f_i^{s-1}|_2` and
@@ -43,15 +43,17 @@ use std::fmt;
 
 use towing_model::{HullModel, ParamError, Scenario};
 
+use crate::costs::angle_difference;
+use crate::engine::{Budget, ScpReport};
 use crate::formation::FormationMap;
 use crate::obstacle::Obstacle;
 use crate::params::PredictionParams;
 use crate::qp::QpBuildError;
-use crate::scp::{angle_difference, ScpReport};
 use crate::ship::{ShipInput, ShipModel, ShipState};
 use crate::ship_mpc::{ShipMpc, ShipMpcParams, ShipStepData};
 use crate::tug::{TowlinePull, TugInput, TugModel, TugState};
-use crate::tug_mpc::{TugMpc, TugMpcParams, TugStepData, HORIZON};
+use crate::tug_mpc::{TugMpc, TugMpcParams, TugStepData};
+use crate::HORIZON;
 
 /// Capacity of the residual history, and the largest `max_iterations` accepted.
 pub const MAX_ITERATIONS: usize = 100;
@@ -214,6 +216,8 @@ pub struct AdmmReport {
     pub iterations: usize,
     /// Whether the stopping rule (28)-(29) ended the loop.
     pub converged: bool,
+    /// Whether the time budget ended the loop.
+    pub budget_hit: bool,
     /// Final primal residuals.
     pub r_pri: [f64; 2],
     /// Final dual residuals.
@@ -273,14 +277,14 @@ impl Admm {
     ) -> Result<Admm, ParamError> {
         settings.validate()?;
         for (i, tug) in tugs.iter().enumerate() {
-            if tug.model().line() != i {
+            if tug.problem().model().line() != i {
                 return Err(ParamError {
                     field: format!("tugs[{i}]"),
-                    reason: format!("models the tug on line {}", tug.model().line()),
+                    reason: format!("models the tug on line {}", tug.problem().model().line()),
                 });
             }
         }
-        let formation = *ship.formation();
+        let formation = *ship.problem().formation();
         Ok(Admm {
             settings,
             ship,
@@ -376,10 +380,9 @@ impl Admm {
         fn shifted<T: Copy>(a: &[T; HORIZON]) -> [T; HORIZON] {
             std::array::from_fn(|h| a[(h + 1).min(HORIZON - 1)])
         }
-        self.ship.set_plan(shifted(self.ship.plan()));
+        self.ship.shift();
         for tug in &mut self.tugs {
-            let plan = shifted(tug.plan());
-            tug.set_plan(plan);
+            tug.shift();
         }
         for i in 0..2 {
             self.lambda[i] = shifted(&self.lambda[i]);
@@ -391,11 +394,17 @@ impl Admm {
     /// Algorithm 1 for one sample (module docs). Failed subproblem solves are
     /// counted in the report; the loop goes on with the kept plan.
     pub fn solve_sample(&mut self, input: &SampleInput<'_>) -> AdmmReport {
+        self.solve_within(input, Budget::unlimited())
+    }
+
+    /// [`Admm::solve_sample`] stopping once `budget` is spent (after at least one
+    /// iteration): the last iterate is applied, as at `max_iterations`.
+    pub fn solve_within(&mut self, input: &SampleInput<'_>, budget: Budget) -> AdmmReport {
         let s = self.settings;
         if !self.warm {
-            self.ship.set_plan([input.previous.ship; HORIZON]);
+            self.ship.set_inputs([input.previous.ship; HORIZON]);
             for (tug, tau) in self.tugs.iter_mut().zip(input.previous.tugs) {
-                tug.set_plan([tau; HORIZON]);
+                tug.set_inputs([tau; HORIZON]);
             }
             self.lambda = [[[0.0; 3]; HORIZON]; 2];
         }
@@ -405,11 +414,12 @@ impl Admm {
             x[2] = input.ship[2] + angle_difference(x[2], input.ship[2]);
         }
         // f^0: the references along the current ship plan.
+        let mut ship_plan = self.ship.inputs();
         let mut ship_states = self
             .ship
+            .problem()
             .model()
-            .rollout::<HORIZON>(&input.ship, self.ship.plan());
-        let mut ship_plan = *self.ship.plan();
+            .rollout::<HORIZON>(&input.ship, &ship_plan);
         let mut f = [[[0.0; 3]; HORIZON]; 2];
         for i in 0..2 {
             self.formation
@@ -422,7 +432,12 @@ impl Admm {
         let mut failed_steps = 0;
         let mut iterations = 0;
         let mut converged = false;
+        let mut budget_hit = false;
         while iterations < s.max_iterations {
+            if iterations > 0 && budget.spent() {
+                budget_hit = true;
+                break;
+            }
             // (1) tug steps given f^{s-1}, the pulls of the ship plan, lambda^{s-1}.
             let mut g = [[[0.0; 3]; HORIZON]; 2];
             for i in 0..2 {
@@ -442,10 +457,10 @@ impl Admm {
                     rho: s.rho,
                     obstacles: input.obstacles,
                 };
-                let report = self.tugs[i].solve_step(&data);
+                let report = self.tugs[i].step(&data);
                 failed_steps += usize::from(!report.qp.is_usable());
                 last_steps[i] = Some(report);
-                for (gh, x) in g[i].iter_mut().zip(self.tugs[i].predicted_states()) {
+                for (gh, x) in g[i].iter_mut().zip(self.tugs[i].predicted()) {
                     *gh = [x[0], x[1], x[2]];
                 }
             }
@@ -460,11 +475,11 @@ impl Admm {
                 obstacles: input.obstacles,
                 heading_floor: input.heading_floor,
             };
-            let report = self.ship.solve_step(&data);
+            let report = self.ship.step(&data);
             failed_steps += usize::from(!report.qp.is_usable());
             last_steps[2] = Some(report);
-            ship_states = *self.ship.predicted_states();
-            ship_plan = *self.ship.plan();
+            ship_states = *self.ship.predicted();
+            ship_plan = self.ship.inputs();
             for i in 0..2 {
                 self.formation
                     .tug_references_into(i, &ship_states, &ship_plan, &mut f[i]);
@@ -500,20 +515,21 @@ impl Admm {
             }
         }
         let last = history[iterations - 1];
-        let first = self.ship.plan()[0];
+        let first = ship_plan[0];
         AdmmReport {
             iterations,
             converged,
+            budget_hit,
             r_pri: last.r_pri,
             r_dual: last.r_dual,
             eps_pri: last.eps_pri,
             eps_dual: last.eps_dual,
             history,
-            last_steps: last_steps.map(|r| r.unwrap_or_else(never_run)),
+            last_steps: last_steps.map(|r| r.unwrap_or_else(ScpReport::never_run)),
             failed_steps,
             tension: [first[0], first[1]],
             angle: [first[2], first[3]],
-            tug_thrust: [self.tugs[0].plan()[0], self.tugs[1].plan()[0]],
+            tug_thrust: [self.tugs[0].inputs()[0], self.tugs[1].inputs()[0]],
         }
     }
 }
@@ -521,21 +537,6 @@ impl Admm {
 /// `a - b`, the heading wrapped.
 fn difference(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], angle_difference(a[2], b[2])]
-}
-
-/// Placeholder for a subproblem that did not run (not reached: at least one
-/// iteration always runs).
-fn never_run() -> ScpReport {
-    ScpReport {
-        qp: crate::QpOutcome::Failed(crate::QpFailure::Other),
-        accepted: false,
-        cost_before: f64::NAN,
-        cost_after: f64::NAN,
-        predicted_decrease: 0.0,
-        ratio: f64::NAN,
-        radius: 0.0,
-        qp_iterations: 0,
-    }
 }
 
 #[cfg(test)]

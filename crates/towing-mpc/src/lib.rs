@@ -2,11 +2,12 @@
 //! "COLREGS-compliant collision avoidance for physically coupled multi-vessel
 //! systems with distributed MPC", Ocean Engineering 260, 111917 (CC BY 4.0),
 //! sections 3.2-3.3, their exact linearisations for sequential convex
-//! programming, and one SCP step of each subproblem of the ADMM: the tug local
-//! problem (25) ([`TugMpc`]) and the coordination problem (26) ([`ShipMpc`]), on
-//! a thin Clarabel wrapper ([`Qp`]), and the ADMM loop of Algorithm 1 over them
-//! ([`Admm`], one control sample), and the centralized MPC of eq. (12) on the
-//! same models, costs and constraints ([`Centralized`]). The FMU is elsewhere.
+//! programming, the optimisation engine ([`engine`]: one SCP step for any
+//! [`Subproblem`] on one working memory, [`Scp`]) with its three subproblems (the
+//! tug local problem (25), [`TugProblem`]; the coordination problem (26),
+//! [`ShipProblem`]; the centralized problem (12)), and the two optimizers on top
+//! behind one trait ([`Optimizer`]): the ADMM of Algorithm 1 ([`Admm`]) and the
+//! centralized SCP ([`Centralized`]). The FMU is elsewhere.
 //!
 //! - [`ShipModel`]: the coordination controller's model, eq. (15) in the
 //!   consistent form of `paper/NOTES.md` (state `[x, y, psi, u, v, r]`, input
@@ -19,11 +20,11 @@
 //!   (analytic for the built-in hulls, finite differences for user hulls; why in
 //!   [`hull`]).
 //! - [`PredictionParams`]: sample time and RK4 substep (zero-order hold).
-//! - [`TugMpc`], [`ShipMpc`]: one SCP step of the ADMM subproblems (25) and (26)
+//! - [`TugMpc`], [`ShipMpc`]: the engine over the ADMM subproblems (25) and (26)
 //!   (condensed QP in the input increments, trust region, accept/reject on the
-//!   true cost; shared machinery in [`scp`]), [`Obstacle`] and the distance cost
-//!   [`DistanceCost`] (`phi`, made honest), [`Qp`]: the Clarabel wrapper with a
-//!   fixed structure updated in place ([`QpOutcome`] as a value).
+//!   true merit), the cost terms they share ([`costs`]), [`Obstacle`] and the
+//!   distance cost [`DistanceCost`] (`phi`, made honest), [`Qp`]: the Clarabel
+//!   wrapper with a fixed structure updated in place ([`QpOutcome`] as a value).
 //!
 //! Physics honesty (DESIGN.md): the models use the plant's own code for
 //! everything the plant computes: the hull ([`towing_model::HullModel::build`] and
@@ -85,34 +86,44 @@
 
 pub mod admm;
 pub mod centralized;
+pub mod costs;
+pub mod engine;
 pub mod formation;
 pub mod hull;
 pub mod lines;
 pub mod obstacle;
+pub mod optimizer;
 pub mod params;
 pub mod qp;
 mod rk4;
-pub mod scp;
 pub mod ship;
 pub mod ship_mpc;
 pub mod tug;
 pub mod tug_mpc;
 
+/// Prediction horizon `H_P` in samples (Du et al. 2022, Table 3): the QPs'
+/// structure is built for it.
+pub const HORIZON: usize = 3;
+
+pub(crate) use engine::condense;
+
 pub use admm::{
     Admm, AdmmBuildError, AdmmReport, AdmmSettings, AppliedCommand, IterationRecord, SampleInput,
 };
 pub use centralized::{Centralized, CentralizedReport, CentralizedSettings, CostBreakdown};
+pub use costs::{angle_difference, ClearanceParams};
+pub use engine::{Budget, Merit, Scp, ScpReport, ScpSettings, Subproblem, TrustRegion};
 pub use formation::FormationMap;
 pub use hull::{JacobianMethod, PredictionHull};
 pub use lines::line_direction;
 pub use obstacle::{DistanceCost, Obstacle};
+pub use optimizer::{MpcReport, Optimizer};
 pub use params::PredictionParams;
 pub use qp::{Qp, QpFailure, QpOutcome};
-pub use scp::{ClearanceParams, ScpReport, ScpSettings, TrustRegion};
 pub use ship::{ShipInput, ShipLinearisation, ShipModel, ShipState};
-pub use ship_mpc::{ShipMpc, ShipMpcParams, ShipStepData, TerminalCost};
+pub use ship_mpc::{ShipMpc, ShipMpcParams, ShipProblem, ShipStepData, TerminalCost};
 pub use tug::{TowlinePull, TugInput, TugLinearisation, TugModel, TugState};
-pub use tug_mpc::{TugMpc, TugMpcParams, TugStepData, HORIZON};
+pub use tug_mpc::{TugMpc, TugMpcParams, TugProblem, TugStepData};
 
 #[cfg(test)]
 mod tests;

@@ -1,12 +1,11 @@
-//! The coordination problem on the ship, eq. (26), as one sequential-convex-
-//! programming step (`docs/controller-design.md`, "Coordination MPC on the ship").
+//! The coordination problem on the ship, eq. (26), as a [`Subproblem`] of the
+//! SCP engine (`docs/controller-design.md`, "Coordination MPC on the ship").
 //!
 //! Decision: `(F_1, F_2, alpha_1, alpha_2)` per sample, `4 H = 12` increments `du`
 //! (index `4 h + k`). Given the ship's state, the command applied in the previous
 //! sample, the reference poses `eta_Sd`, the tugs' reported poses `g_i`, the
 //! multipliers `lambda_i` and `rho`, the step linearises the ship's rollout around
-//! the plan, condenses the states as in [`crate::tug_mpc`], and minimises the
-//! quadratic model ([`crate::scp`]) of
+//! the plan, condenses the states, and minimises the quadratic model of
 //!
 //! ```text
 //! sum_h  w_S1 |eta_{h+1} - eta_Sd,h|^2 + w_S2 |nu_{h+1}|^2 + w_S3 sum_j phi(d_j(p_{h+1}))
@@ -19,39 +18,29 @@
 //! the ADMM terms are the residual `g - f` with linear weight `lambda`.) Heading
 //! differences are wrapped to `(-pi, pi]`.
 //!
-//! Constraints: the box `0 <= F_i <= F_max`, `|alpha_i| <= alpha_max` merged with the
-//! trust region and, for the first sample, with the rate bound measured from the
-//! previous command; the rate bounds between samples 1..H as 2 rows per channel and
-//! sample (16 rows): 24 box rows + 16 rows in all. Before the step the plan is
-//! projected onto the constraints (the previous command first clamped into the
-//! box, then each sample clamped into the box and the rate band of the sample
-//! before), so that `du = 0` is feasible and the QP always has a solution.
-//!
-//! Obstacles: the distance cost `w_S3 phi` and the hard clearance rows with
-//! L1-penalised slacks as in [`crate::tug_mpc`] ([`ClearanceParams`]; default
-//! `d_min = 0.65 m`, about half a CyberShip II).
-//!
-//! Allocation: as [`crate::tug_mpc`]; all buffers are made in [`ShipMpc::new`].
+//! Constraints (the engine's [`InputSpace`]): the box `F_min <= F_i <= F_max`,
+//! `|alpha_i| <= alpha_max` and the rate bounds (eq. (17)-(18), (20)-(21)), the
+//! first sample's measured from the previous command; the hard clearance rows with
+//! L1-penalised slacks ([`ClearanceParams`]; default `d_min = 0.75 m`, about half
+//! a CyberShip II plus a margin).
 
 // Index loops over (sample, channel) pairs: the indices also address the
-// flat increment vector (`3 h + c`, `4 h + k`), clearer than zipped iterators.
+// flat increment vector (`4 h + k`), clearer than zipped iterators.
 #![allow(clippy::needless_range_loop)]
 
 use nalgebra::Matrix6x4;
 
+use crate::costs::{angle_difference, obstacle_terms, ship_stage_terms, ClearanceParams};
+use crate::engine::{
+    Block, BlockMut, Channel, InputSpace, QuadModel, RowSet, Scp, ScpSettings, SlotRows, Subproblem,
+};
 use crate::formation::FormationMap;
 use crate::obstacle::{DistanceCost, Obstacle};
 use crate::qp::QpBuildError;
-use crate::scp::{
-    angle_difference, box_qp, condense, load_layout, obstacle_terms, solve_layout, Clearance,
-    ClearanceParams, QuadModel, ScpReport, ScpSettings, TrustRegion,
-};
 use crate::ship::{ShipInput, ShipLinearisation, ShipModel, ShipState};
-use crate::tug_mpc::HORIZON;
-use crate::Qp;
+use crate::{condense, HORIZON};
 
 const N: usize = 4 * HORIZON;
-const RATE_ROWS: usize = 2 * 4 * (HORIZON - 1);
 
 /// Parameters of the coordination problem.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -99,7 +88,7 @@ pub struct ShipMpcParams {
     /// `w_P`: weight of the one-sided heading term `w_P min(0, psi_h - psi_floor)^2`
     /// (per rad^2), active only when the sample carries a heading floor
     /// ([`ShipStepData::heading_floor`]). Not in the paper: see
-    /// [`ship_stage_terms`].
+    /// [`crate::costs`].
     pub port_turn_weight: f64,
 }
 
@@ -154,17 +143,25 @@ impl ShipMpcParams {
         }
     }
 
+    /// The four input channels of a sample (`F_1, F_2, alpha_1, alpha_2`).
+    #[must_use]
+    pub fn channels(&self) -> [Channel; 4] {
+        std::array::from_fn(|k| {
+            let (lower, upper, rate) = self.channel_limits(k);
+            Channel {
+                lower,
+                upper,
+                rate,
+                trust_scale: self.trust_scale[k / 2],
+            }
+        })
+    }
+
     /// Projects `plan` onto the bounds and the rate bounds, sample by sample,
     /// the first measured from `previous` (itself clamped to the bounds).
     pub fn project(&self, plan: &mut [ShipInput; HORIZON], previous: &ShipInput) {
-        for k in 0..4 {
-            let (lo, hi, rate) = self.channel_limits(k);
-            let mut before = previous[k].clamp(lo, hi);
-            for u in plan.iter_mut() {
-                u[k] = u[k].clamp(lo.max(before - rate), hi.min(before + rate));
-                before = u[k];
-            }
-        }
+        let space = InputSpace::new(self.channels().to_vec(), HORIZON);
+        space.project(plan.as_flattened_mut(), previous);
     }
 }
 
@@ -191,108 +188,55 @@ pub struct ShipStepData<'a> {
     pub heading_floor: Option<f64>,
 }
 
-/// The coordination MPC (module docs).
+/// The coordination problem (module docs).
 #[derive(Debug)]
-pub struct ShipMpc {
+pub struct ShipProblem {
     model: ShipModel,
     formation: FormationMap,
     params: ShipMpcParams,
-    /// Per number of obstacle slots per sample `c` (`0..=max_obstacles`), the QP,
-    /// its clearance rows and its first rate row: a step uses the smallest layout
-    /// holding the obstacles present (unused slots only add rows, see
-    /// [`Clearance::copy_from`]); the last one records the linearisation.
-    variants: Vec<(Qp, Clearance, usize)>,
-    trust: TrustRegion,
-    plan: [ShipInput; HORIZON],
-    candidate: [ShipInput; HORIZON],
-    lin: [ShipLinearisation; HORIZON],
-    /// The `(state, plan)` that `lin` and `sens` were computed for: a step from
-    /// the same point (after a rejected step) reuses them.
-    lin_key: Option<(ShipState, [ShipInput; HORIZON])>,
-    sens: [[Matrix6x4<f64>; HORIZON]; HORIZON],
-    states: [ShipState; HORIZON],
-    candidate_states: [ShipState; HORIZON],
-    quad: QuadModel,
+    space: InputSpace,
 }
 
-impl ShipMpc {
-    /// The problem for `model` and `formation`; the plan at zero tension, straight
-    /// lines.
-    pub fn new(
-        model: ShipModel,
-        formation: FormationMap,
-        params: ShipMpcParams,
-    ) -> Result<ShipMpc, QpBuildError> {
-        // Rate rows: row 2 (4 (h - 1) + k) (+1): du_{h,k} - du_{h-1,k} <= .. (and -).
-        let mut entries = Vec::with_capacity(2 * RATE_ROWS);
-        for h in 1..HORIZON {
-            for k in 0..4 {
-                let row = 2 * (4 * (h - 1) + k);
-                entries.extend([
-                    (row, 4 * h + k),
-                    (row, 4 * (h - 1) + k),
-                    (row + 1, 4 * h + k),
-                    (row + 1, 4 * (h - 1) + k),
-                ]);
-            }
-        }
-        let n_rate = entries.len();
-        let variants = (0..=params.clearance.max_obstacles)
-            .map(|max_obstacles| {
-                let cp = ClearanceParams {
-                    max_obstacles,
-                    ..params.clearance
-                };
-                let mut entries = entries.clone();
-                let ns = Clearance::slacks(&cp, HORIZON);
-                entries.extend(Clearance::entries(&cp, 4, HORIZON, RATE_ROWS));
-                let (mut qp, mut slots) = box_qp(N + ns, N, RATE_ROWS + ns, &entries)?;
-                for (slot, v) in slots[..n_rate]
-                    .iter()
-                    .zip([1.0, -1.0, -1.0, 1.0].iter().cycle())
-                {
-                    qp.a_mut()[*slot] = *v;
-                }
-                let rate_row = 2 * (N + ns);
-                let clearance_slots = slots.split_off(n_rate);
-                let clearance =
-                    Clearance::new(cp, 4, HORIZON, rate_row + RATE_ROWS, clearance_slots);
-                Ok((qp, clearance, rate_row))
-            })
-            .collect::<Result<Vec<_>, QpBuildError>>()?;
-        Ok(ShipMpc {
+/// The linearised rollout of the ship: per sample the linearised step, the
+/// condensed sensitivities (`condense`, Maciejowski 2002, section 3.1) and the nominal states.
+#[derive(Debug, Clone)]
+pub struct ShipLinearised {
+    steps: [ShipLinearisation; HORIZON],
+    sens: [[Matrix6x4<f64>; HORIZON]; HORIZON],
+    states: [ShipState; HORIZON],
+}
+
+/// The coordination problem's soft rows: the clearance rows.
+#[derive(Debug, Clone)]
+pub struct ShipRows {
+    clearance: SlotRows,
+}
+
+impl RowSet for ShipRows {
+    fn blocks(&self) -> impl Iterator<Item = Block<'_>> {
+        std::iter::once(Block::Slots(&self.clearance))
+    }
+    fn blocks_mut(&mut self) -> impl Iterator<Item = BlockMut<'_>> {
+        std::iter::once(BlockMut::Slots(&mut self.clearance))
+    }
+}
+
+/// A flat plan (`4 h + k`) as inputs per sample.
+#[must_use]
+pub fn ship_inputs(plan: &[f64]) -> [ShipInput; HORIZON] {
+    std::array::from_fn(|h| std::array::from_fn(|k| plan[4 * h + k]))
+}
+
+impl ShipProblem {
+    /// The problem for `model` and `formation`.
+    #[must_use]
+    pub fn new(model: ShipModel, formation: FormationMap, params: ShipMpcParams) -> ShipProblem {
+        ShipProblem {
+            space: InputSpace::new(params.channels().to_vec(), HORIZON),
             model,
             formation,
             params,
-            variants,
-            trust: TrustRegion::new(params.scp),
-            plan: [[0.0; 4]; HORIZON],
-            candidate: [[0.0; 4]; HORIZON],
-            lin: [ShipLinearisation::default(); HORIZON],
-            lin_key: None,
-            sens: [[Matrix6x4::zeros(); HORIZON]; HORIZON],
-            states: [[0.0; 6]; HORIZON],
-            candidate_states: [[0.0; 6]; HORIZON],
-            quad: QuadModel::new(N),
-        })
-    }
-
-    /// The current plan.
-    #[must_use]
-    pub fn plan(&self) -> &[ShipInput; HORIZON] {
-        &self.plan
-    }
-
-    /// Replaces the plan (warm start); it is projected onto the constraints at the
-    /// next step.
-    pub fn set_plan(&mut self, plan: [ShipInput; HORIZON]) {
-        self.plan = plan;
-    }
-
-    /// The predicted ship states of the plan as of the last step.
-    #[must_use]
-    pub fn predicted_states(&self) -> &[ShipState; HORIZON] {
-        &self.states
+        }
     }
 
     /// The prediction model.
@@ -312,224 +256,119 @@ impl ShipMpc {
     pub fn params(&self) -> &ShipMpcParams {
         &self.params
     }
+}
 
-    /// The trust region.
-    #[must_use]
-    pub fn trust_region(&self) -> &TrustRegion {
-        &self.trust
+impl Subproblem for ShipProblem {
+    type Data<'a> = ShipStepData<'a>;
+    type Trajectory = [ShipState; HORIZON];
+    type Linearisation = ShipLinearised;
+    type Key = ShipState;
+    type Rows = ShipRows;
+    type Cost = f64;
+
+    fn space(&self) -> &InputSpace {
+        &self.space
     }
 
-    /// The trust region, to reset it (e.g. at a new sample).
-    pub fn trust_region_mut(&mut self) -> &mut TrustRegion {
-        &mut self.trust
+    fn rows(&self) -> ShipRows {
+        ShipRows {
+            clearance: self.params.clearance.rows(4),
+        }
     }
 
-    /// The true cost of `plan` for `data` (nonlinear rollout).
-    #[must_use]
-    pub fn cost(&self, plan: &[ShipInput; HORIZON], data: &ShipStepData<'_>) -> f64 {
-        let states = self.model.rollout(&data.state, plan);
-        let mut quad = QuadModel::new(0);
-        quad.reset(true);
+    fn buffers(&self) -> (Self::Trajectory, ShipLinearised) {
+        (
+            [[0.0; 6]; HORIZON],
+            ShipLinearised {
+                steps: [ShipLinearisation::default(); HORIZON],
+                sens: [[Matrix6x4::zeros(); HORIZON]; HORIZON],
+                states: [[0.0; 6]; HORIZON],
+            },
+        )
+    }
+
+    fn previous(&self, data: &ShipStepData<'_>, out: &mut [f64]) {
+        out.copy_from_slice(&data.previous);
+    }
+
+    fn key(&self, data: &ShipStepData<'_>) -> ShipState {
+        data.state
+    }
+
+    fn rollout(&self, data: &ShipStepData<'_>, plan: &[f64], out: &mut Self::Trajectory) {
+        self.model
+            .rollout_into(&data.state, &ship_inputs(plan), out);
+    }
+
+    fn linearise(&self, data: &ShipStepData<'_>, plan: &[f64], lin: &mut ShipLinearised) {
+        self.model
+            .linearise_rollout_into(&data.state, &ship_inputs(plan), &mut lin.steps);
+        condense(
+            std::array::from_fn(|h| &lin.steps[h].a),
+            std::array::from_fn(|h| &lin.steps[h].b),
+            &mut lin.sens,
+        );
+        for h in 0..HORIZON {
+            lin.states[h] = lin.steps[h].x_next;
+        }
+    }
+
+    fn nominal(lin: &ShipLinearised) -> &Self::Trajectory {
+        &lin.states
+    }
+
+    fn terms(
+        &self,
+        quad: &mut QuadModel,
+        traj: &Self::Trajectory,
+        plan: &[f64],
+        model: Option<(&ShipLinearised, &mut ShipRows)>,
+        data: &ShipStepData<'_>,
+    ) -> f64 {
+        let (sens, clearance) = match model {
+            Some((lin, rows)) => (Some(&lin.sens), Some(&mut rows.clearance)),
+            None => (None, None),
+        };
         accumulate(
-            &mut quad,
+            quad,
             &self.params,
             &self.formation,
-            &states,
-            plan,
-            None,
-            None,
+            traj,
+            &ship_inputs(plan),
+            sens,
+            clearance,
             data,
         );
         quad.value
     }
-
-    /// One SCP step (module docs). Allocation-free.
-    pub fn solve_step(&mut self, data: &ShipStepData<'_>) -> ScpReport {
-        let limits: [(f64, f64, f64); 4] = std::array::from_fn(|k| self.params.channel_limits(k));
-        // Project the plan onto the constraints.
-        self.params.project(&mut self.plan, &data.previous);
-        let key = (data.state, self.plan);
-        if self.lin_key != Some(key) {
-            self.model
-                .linearise_rollout_into(&data.state, &self.plan, &mut self.lin);
-            condense(
-                std::array::from_fn(|h| &self.lin[h].a),
-                std::array::from_fn(|h| &self.lin[h].b),
-                &mut self.sens,
-            );
-            self.lin_key = Some(key);
-        }
-        for h in 0..HORIZON {
-            self.states[h] = self.lin[h].x_next;
-        }
-        self.quad.reset(false);
-        let full = self.variants.len() - 1;
-        self.variants[full].1.clear();
-        accumulate(
-            &mut self.quad,
-            &self.params,
-            &self.formation,
-            &self.states,
-            &self.plan,
-            Some(&self.sens),
-            Some(&mut self.variants[full].1),
-            data,
-        );
-        let radius = self.trust.radius();
-        let (mut box_lo, mut box_hi) = ([0.0; N], [0.0; N]);
-        for k in 0..4 {
-            let (lo, hi, rate) = limits[k];
-            let tr = radius * self.params.trust_scale[k / 2];
-            let prev = data.previous[k].clamp(lo, hi);
-            for h in 0..HORIZON {
-                let u = self.plan[h][k];
-                let (mut l, mut r) = ((lo - u).max(-tr), (hi - u).min(tr));
-                if h == 0 {
-                    l = l.max(prev - rate - u);
-                    r = r.min(prev + rate - u);
-                }
-                // du = 0 is feasible after the projection; keep it so with rounding.
-                box_lo[4 * h + k] = l.min(0.0);
-                box_hi[4 * h + k] = r.max(0.0);
-            }
-        }
-        let used = load_layout(
-            &mut self.variants,
-            ship_layout,
-            &self.quad,
-            &box_lo,
-            &box_hi,
-        );
-        let cost_before = self.quad.value;
-        let (qp, rows, rate_row) = &mut self.variants[used];
-        let rate_row = *rate_row;
-        for k in 0..4 {
-            let rate = limits[k].2;
-            for h in 1..HORIZON {
-                let diff = self.plan[h][k] - self.plan[h - 1][k];
-                let row = rate_row + 2 * (4 * (h - 1) + k);
-                qp.b_mut()[row] = (rate - diff).max(0.0);
-                qp.b_mut()[row + 1] = (rate + diff).max(0.0);
-            }
-        }
-        let (outcome, iterations, predicted) =
-            match solve_layout(qp, rows, &self.quad, N, &mut self.trust) {
-                Ok(solved) => solved,
-                Err(report) => return report,
-            };
-        let du = qp.solution();
-        // The candidate, projected as the plan was (removes the solver's 1e-6
-        // tolerance on the constraints).
-        self.candidate =
-            std::array::from_fn(|h| std::array::from_fn(|k| self.plan[h][k] + du[4 * h + k]));
-        self.params.project(&mut self.candidate, &data.previous);
-        self.model
-            .rollout_into(&data.state, &self.candidate, &mut self.candidate_states);
-        self.quad.reset(true);
-        accumulate(
-            &mut self.quad,
-            &self.params,
-            &self.formation,
-            &self.candidate_states,
-            &self.candidate,
-            None,
-            None,
-            data,
-        );
-        let cost_candidate = self.quad.value;
-        let (accepted, ratio) = self.trust.judge(cost_before, cost_candidate, predicted);
-        if accepted {
-            self.plan = self.candidate;
-            self.states = self.candidate_states;
-        }
-        ScpReport::judged(
-            outcome,
-            [cost_before, cost_candidate, predicted],
-            accepted,
-            ratio,
-            self.trust.radius(),
-            iterations,
-        )
-    }
 }
 
-/// A coordination layout's QP and clearance rows.
-fn ship_layout(v: &mut (Qp, Clearance, usize)) -> (&mut Qp, &mut Clearance) {
-    (&mut v.0, &mut v.1)
-}
+/// The coordination MPC: the SCP engine over [`ShipProblem`].
+pub type ShipMpc = Scp<ShipProblem>;
 
-/// The ship's own terms of eq. (13) at one predicted state `x` (after sample
-/// `h`) reached with the sample's input `u`, shared by the coordination and the
-/// centralized problems: `w_S1 |eta - eta_d|^2` (heading wrapped), the velocity
-/// term (`w_S2`, the yaw rate optionally weighted apart), the optional
-/// regularisers of the tensions and angles and, on the last sample, the optional
-/// terminal term. `rows[c]` is `d x_c / du` over the QP's variables, `columns`
-/// the QP columns of `u` (`None`: value only).
-#[allow(clippy::too_many_arguments)] // the pieces of one stage; two call sites
-pub(crate) fn ship_stage_terms<const N: usize>(
-    quad: &mut QuadModel,
-    params: &ShipMpcParams,
-    x: &ShipState,
-    reference: [f64; 3],
-    u: &ShipInput,
-    rows: &[[f64; N]; 6],
-    columns: Option<[usize; 4]>,
-    last: bool,
-    heading_floor: Option<f64>,
-) {
-    let [w1, w2, _] = params.weights;
-    if let Some(floor) = heading_floor {
-        // One-sided: zero (with its gradient) at or to starboard of the floor.
-        let e = angle_difference(x[2], floor);
-        if e < 0.0 {
-            quad.curved(e * e, 2.0 * e, 2.0, params.port_turn_weight, &rows[2]);
-        }
+impl Scp<ShipProblem> {
+    /// The problem for `model` and `formation`; the plan at zero tension, straight
+    /// lines.
+    ///
+    /// # Errors
+    /// A QP that cannot be built.
+    pub fn new(
+        model: ShipModel,
+        formation: FormationMap,
+        params: ShipMpcParams,
+    ) -> Result<ShipMpc, QpBuildError> {
+        Scp::with_problem(ShipProblem::new(model, formation, params), params.scp)
     }
-    let err = [
-        x[0] - reference[0],
-        x[1] - reference[1],
-        angle_difference(x[2], reference[2]),
-    ];
-    let wv = [w2, w2, params.yaw_rate_weight.unwrap_or(w2)];
-    for c in 0..3 {
-        quad.residual(err[c], w1, 0.0, &rows[c]);
-        quad.residual(x[3 + c], wv[c], 0.0, &rows[3 + c]);
+
+    /// The plan as inputs per sample.
+    #[must_use]
+    pub fn inputs(&self) -> [ShipInput; HORIZON] {
+        ship_inputs(self.plan())
     }
-    let wu = [
-        params.tension_weight,
-        params.tension_weight,
-        params.angle_weight,
-        params.angle_weight,
-    ];
-    for (k, w) in wu.into_iter().enumerate() {
-        if w > 0.0 {
-            let mut row = [0.0; N];
-            if let Some(cols) = columns {
-                row[cols[k]] = 1.0;
-            }
-            quad.residual(u[k], w, 0.0, &row);
-        }
-    }
-    if let (true, Some(t)) = (last, params.terminal) {
-        // The pose error extrapolated `tau` seconds with the predicted velocity
-        // over ground: e + tau eta_dot, eta_dot = R(psi) nu.
-        let (sn, cs) = x[2].sin_cos();
-        let xdot = [cs * x[3] - sn * x[4], sn * x[3] + cs * x[4], x[5]];
-        // d eta_dot / d(psi, u, v, r).
-        let d_psi = [-sn * x[3] - cs * x[4], cs * x[3] - sn * x[4], 0.0];
-        let d_nu = [[cs, -sn, 0.0], [sn, cs, 0.0], [0.0, 0.0, 1.0]];
-        for c in 0..3 {
-            let mut row = [0.0; N];
-            for (v, slot) in row.iter_mut().enumerate() {
-                *slot = rows[c][v]
-                    + t.horizon
-                        * (d_psi[c] * rows[2][v]
-                            + d_nu[c][0] * rows[3][v]
-                            + d_nu[c][1] * rows[4][v]
-                            + d_nu[c][2] * rows[5][v]);
-            }
-            quad.residual(err[c] + t.horizon * xdot[c], t.weight, 0.0, &row);
-        }
+
+    /// Replaces the plan (warm start); it is projected at the next step.
+    pub fn set_inputs(&mut self, plan: [ShipInput; HORIZON]) {
+        self.set_plan(plan.as_flattened());
     }
 }
 
@@ -543,7 +382,7 @@ fn accumulate(
     states: &[ShipState; HORIZON],
     plan: &[ShipInput; HORIZON],
     sens: Option<&[[Matrix6x4<f64>; HORIZON]; HORIZON]>,
-    mut clearance: Option<&mut Clearance>,
+    mut clearance: Option<&mut SlotRows>,
     data: &ShipStepData<'_>,
 ) {
     let w3 = params.weights[2];
@@ -634,7 +473,7 @@ mod tests {
     fn data_at_rest(mpc: &ShipMpc, reference: [f64; 3], rho: f64) -> ShipStepData<'static> {
         let mut tug_poses = [[[0.0; 3]; HORIZON]; 2];
         for (i, poses) in tug_poses.iter_mut().enumerate() {
-            *poses = [mpc.formation.tug_reference([0.0; 3], 0.0, i); HORIZON];
+            *poses = [mpc.problem().formation().tug_reference([0.0; 3], 0.0, i); HORIZON];
         }
         ShipStepData {
             state: [0.0; 6],
@@ -649,16 +488,16 @@ mod tests {
     }
 
     fn check_feasible(mpc: &ShipMpc, previous: &ShipInput) -> Result<(), String> {
-        let p = mpc.params();
+        let p = mpc.problem().params();
         let tol = 1e-9;
         let mut before = *previous;
         for k in 0..4 {
-            let (lo, hi, _) = mpc.params().channel_limits(k);
+            let (lo, hi, _) = mpc.problem().params().channel_limits(k);
             before[k] = before[k].clamp(lo, hi);
         }
-        for u in mpc.plan() {
+        for u in &mpc.inputs() {
             for k in 0..4 {
-                let (lo, hi, rate) = mpc.params().channel_limits(k);
+                let (lo, hi, rate) = mpc.problem().params().channel_limits(k);
                 if u[k] < lo - tol || u[k] > hi + tol {
                     return Err(format!("bound {k}: {u:?}"));
                 }
@@ -685,9 +524,9 @@ mod tests {
             let mut data = data_at_rest(&mpc, [x + dx, y + dy, psi], 1.0);
             data.state = [x, y, psi, u, v, r];
             data.previous = [f1, f2, a1, a2];
-            mpc.set_plan([[f1 + 1.0, f2 - 1.0, a1 * 2.0, -a2]; HORIZON]);
+            mpc.set_inputs([[f1 + 1.0, f2 - 1.0, a1 * 2.0, -a2]; HORIZON]);
             for _ in 0..4 {
-                let report = mpc.solve_step(&data);
+                let report = mpc.step(&data);
                 prop_assert!(report.qp.is_usable(), "{:?}", report);
                 if let Err(e) = check_feasible(&mpc, &data.previous) {
                     return Err(TestCaseError::fail(e));
@@ -702,7 +541,7 @@ mod tests {
         let data = data_at_rest(&mpc, [2.0, 0.0, 0.0], 0.0);
         let mut last = mpc.cost(mpc.plan(), &data);
         for _ in 0..40 {
-            let report = mpc.solve_step(&data);
+            let report = mpc.step(&data);
             assert!(report.qp.is_usable(), "{report:?}");
             let now = mpc.cost(mpc.plan(), &data);
             assert!(now <= last + 1e-12, "{now} > {last}");
@@ -711,11 +550,11 @@ mod tests {
         }
         // The first move pulls ahead harder than astern (the last sample may brake:
         // the velocity weight w_S2 = 75 prices the speed left at the horizon).
-        let plan = mpc.plan();
+        let plan = mpc.inputs();
         assert!(plan[0][1] > plan[0][0] + 0.1, "{plan:?}");
         let total = |k: usize| plan.iter().map(|u| u[k]).sum::<f64>();
         assert!(total(1) > total(0), "{plan:?}");
-        let states = mpc.predicted_states();
+        let states = mpc.predicted();
         assert!(states[HORIZON - 1][0] > 0.0 && states[HORIZON - 1][3] > 0.0);
     }
 
@@ -732,9 +571,9 @@ mod tests {
             let mut data = data_at_rest(&mpc, [1.0, -1.0, -0.5], 0.0);
             data.heading_floor = floor;
             for _ in 0..40 {
-                assert!(mpc.solve_step(&data).qp.is_usable());
+                assert!(mpc.step(&data).qp.is_usable());
             }
-            mpc.predicted_states().map(|x| x[2])
+            mpc.predicted().map(|x| x[2])
         };
         let free = run(None);
         assert!(free[HORIZON - 1] < -1e-3, "{free:?}");
@@ -755,12 +594,12 @@ mod tests {
             for g in &mut data.tug_poses[1] {
                 g[1] += shift;
             }
-            mpc.set_plan([[1.0, 1.0, 0.0, 0.0]; HORIZON]);
+            mpc.set_inputs([[1.0, 1.0, 0.0, 0.0]; HORIZON]);
             data.previous = [1.0, 1.0, 0.0, 0.0];
             for _ in 0..30 {
-                assert!(mpc.solve_step(&data).qp.is_usable());
+                assert!(mpc.step(&data).qp.is_usable());
             }
-            *mpc.plan()
+            mpc.inputs()
         };
         let straight = run(0.0);
         let shifted = run(1.0);
@@ -795,11 +634,11 @@ mod tests {
             data.previous = [0.0; 4]; // at rest, lines slack: holding still is feasible
 
             for _ in 0..40 {
-                let report = mpc.solve_step(&data);
+                let report = mpc.step(&data);
                 assert!(report.qp.is_usable(), "{report:?}");
                 check_feasible(&mpc, &data.previous).unwrap();
             }
-            mpc.predicted_states()
+            mpc.predicted()
                 .iter()
                 .map(|x| obstacles[0].distance([x[0], x[1]]).0)
                 .fold(f64::INFINITY, f64::min)

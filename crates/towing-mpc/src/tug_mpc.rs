@@ -1,61 +1,41 @@
-//! A tug's local problem, eq. (25), as one sequential-convex-programming step
+//! A tug's local problem, eq. (25), as a [`Subproblem`] of the SCP engine
 //! (`docs/controller-design.md`, "Tug local MPCs").
 //!
 //! Decision: the thrust plan `tau_Ti` over the horizon, `3 H = 9` increments
 //! `du` (index `3 h + j`, `j` = X, Y, N). Given the tug's state, the towline pull per
 //! sample from the coordination plan (tension, bearing), the reference poses `f_i`
 //! (from [`crate::FormationMap`] along the coordination's predicted ship
-//! trajectory), the multipliers `lambda_i` and `rho`, the step
+//! trajectory), the multipliers `lambda_i` and `rho`, the step linearises the
+//! rollout around the current plan (exact Jacobians of the discretised model) and
+//! condenses the states (`x_{h+1} ~ x_{h+1} + sum_{k <= h} S_{h,k} du_k`,
+//! `condense`), and minimises the quadratic model of
 //!
-//! 1. linearises the rollout around the current plan (exact Jacobians of the
-//!    discretised model) and condenses the states: `x_{h+1} ~ x_{h+1} + sum_{k <= h}
-//!    S_{h,k} du_k`, `S_{h,h} = B_h`, `S_{h,k} = A_h S_{h-1,k}`;
-//! 2. builds the convex quadratic model ([`crate::scp`]) of
+//! ```text
+//! sum_h  w_1 |eta_{h+1} - f_h|^2 + w_2 |nu_{h+1}|^2 + w_3 sum_j phi(d_j(p_{h+1}))
+//!      + lambda_h^T (eta_{h+1} - f_h) + rho/2 |eta_{h+1} - f_h|^2
+//! ```
 //!
-//!    ```text
-//!    sum_h  w_1 |eta_{h+1} - f_h|^2 + w_2 |nu_{h+1}|^2 + w_3 sum_j phi(d_j(p_{h+1}))
-//!         + lambda_h^T (eta_{h+1} - f_h) + rho/2 |eta_{h+1} - f_h|^2
-//!    ```
-//!
-//!    (heading difference wrapped to `(-pi, pi]`; the state after sample `h` is
-//!    compared with the reference of sample `h`, the layout of
-//!    [`crate::FormationMap::tug_references_into`]);
-//! 3. solves the QP with one box per variable: the thrust bounds `|tau| <= tau_max`
-//!    (19) intersected with the trust region `|du_j| <= radius * scale_j`;
-//! 4. accepts or rejects the candidate by the ratio of the true (nonlinear
-//!    rollout) to the predicted cost decrease, and adapts the radius.
-//!
-//! 5. the hard clearance rows of the design document, linearised, with an L1-
-//!    penalised slack per sample and obstacle slot ([`ClearanceParams`]): the QP
-//!    variables are the 9 increments and `3 c` slacks, `c <= max_obstacles` the
-//!    obstacle slots in use (one QP per `c`, built in [`TugMpc::new`]; rows the
-//!    increments' boxes imply are left out).
-//!
-//! A step from the point of the last linearisation (same state, plan and pulls:
-//! after a rejected step) reuses the linearised rollout.
-//!
-//! Allocation: everything is allocated in [`TugMpc::new`] (the QPs and their solvers,
-//! the model buffers); the plan, rollouts, linearisations and sensitivities are
-//! fixed-size arrays. [`TugMpc::solve_step`] only writes into them, and into
-//! Clarabel's preallocated data (`update_P/q/A/b`, then `solve`).
+//! (heading difference wrapped to `(-pi, pi]`; the state after sample `h` is
+//! compared with the reference of sample `h`, the layout of
+//! [`crate::FormationMap::tug_references_into`]) under the thrust bounds
+//! `|tau| <= tau_max` (19) and the hard clearance rows of the design document
+//! with L1-penalised slacks ([`ClearanceParams`]).
 
 // Index loops over (sample, channel) pairs: the indices also address the
-// flat increment vector (`3 h + c`, `4 h + k`), clearer than zipped iterators.
+// flat increment vector (`3 h + c`), clearer than zipped iterators.
 #![allow(clippy::needless_range_loop)]
 
 use nalgebra::Matrix6x3;
 
+use crate::costs::{angle_difference, obstacle_terms, ClearanceParams};
+use crate::engine::{
+    Block, BlockMut, Channel, InputSpace, QuadModel, RowSet, Scp, ScpSettings, SlotRows, Subproblem,
+};
 use crate::obstacle::{DistanceCost, Obstacle};
 use crate::qp::QpBuildError;
-use crate::scp::{
-    angle_difference, box_qp, condense, load_layout, obstacle_terms, solve_layout, Clearance,
-    ClearanceParams, QuadModel, ScpReport, ScpSettings, TrustRegion,
-};
 use crate::tug::{TowlinePull, TugInput, TugLinearisation, TugModel, TugState};
-use crate::Qp;
+use crate::{condense, HORIZON};
 
-/// Prediction horizon `H_P` (Table 3).
-pub const HORIZON: usize = 3;
 const N: usize = 3 * HORIZON;
 
 /// Parameters of a tug's local problem.
@@ -71,7 +51,8 @@ pub struct TugMpcParams {
     pub scp: ScpSettings,
     /// `phi` of the distance term.
     pub distance: DistanceCost,
-    /// Hard clearance rows (default `d_min = 0.5 m`, about half a TitoNeri).
+    /// Hard clearance rows (default `d_min = 0.6 m`, about half a TitoNeri plus
+    /// a margin).
     pub clearance: ClearanceParams,
 }
 
@@ -85,6 +66,20 @@ impl Default for TugMpcParams {
             distance: DistanceCost::default(),
             clearance: ClearanceParams::with_min_distance(0.6),
         }
+    }
+}
+
+impl TugMpcParams {
+    /// The three input channels of a sample (`X, Y, N`): bounded, no rate bound.
+    #[must_use]
+    pub fn channels(&self) -> [Channel; 3] {
+        std::array::from_fn(|c| {
+            Channel::bounded(
+                -self.thrust_limit[c],
+                self.thrust_limit[c],
+                self.trust_scale[c],
+            )
+        })
     }
 }
 
@@ -106,87 +101,53 @@ pub struct TugStepData<'a> {
     pub obstacles: &'a [Obstacle],
 }
 
-/// A tug's local MPC (module docs).
+/// A tug's local problem (module docs).
 #[derive(Debug)]
-pub struct TugMpc {
+pub struct TugProblem {
     model: TugModel,
     params: TugMpcParams,
-    /// Per number of obstacle slots per sample `c` (`0..=max_obstacles`), the QP
-    /// and its clearance rows: a step uses the smallest layout holding the
-    /// obstacles present (unused slots only add rows, see [`Clearance::copy_from`]);
-    /// the last one records the linearisation.
-    variants: Vec<(Qp, Clearance)>,
-    trust: TrustRegion,
-    plan: [TugInput; HORIZON],
-    candidate: [TugInput; HORIZON],
-    lin: [TugLinearisation; HORIZON],
-    /// The `(state, plan, pulls)` that `lin`, `sens` and `states` were computed
-    /// for: a step from the same point (after a rejected step) reuses them.
-    lin_key: Option<(TugState, [TugInput; HORIZON], [TowlinePull; HORIZON])>,
-    sens: [[Matrix6x3<f64>; HORIZON]; HORIZON],
-    states: [TugState; HORIZON],
-    candidate_states: [TugState; HORIZON],
-    quad: QuadModel,
+    space: InputSpace,
 }
 
-impl TugMpc {
-    /// The problem for `model`, the plan at zero thrust.
-    pub fn new(model: TugModel, params: TugMpcParams) -> Result<TugMpc, QpBuildError> {
-        let variants = (0..=params.clearance.max_obstacles)
-            .map(|max_obstacles| {
-                let cp = ClearanceParams {
-                    max_obstacles,
-                    ..params.clearance
-                };
-                let ns = Clearance::slacks(&cp, HORIZON);
-                let entries = Clearance::entries(&cp, 3, HORIZON, 0);
-                let (qp, slots) = box_qp(N + ns, N, ns, &entries)?;
-                let clearance = Clearance::new(cp, 3, HORIZON, 2 * (N + ns), slots);
-                Ok((qp, clearance))
-            })
-            .collect::<Result<Vec<_>, QpBuildError>>()?;
-        Ok(TugMpc {
+/// The linearised rollout of a tug: per sample the linearised step (without the
+/// pull sensitivities), the condensed sensitivities and the nominal states.
+#[derive(Debug, Clone)]
+pub struct TugLinearised {
+    steps: [TugLinearisation; HORIZON],
+    sens: [[Matrix6x3<f64>; HORIZON]; HORIZON],
+    states: [TugState; HORIZON],
+}
+
+/// A tug problem's soft rows: the clearance rows.
+#[derive(Debug, Clone)]
+pub struct TugRows {
+    clearance: SlotRows,
+}
+
+impl RowSet for TugRows {
+    fn blocks(&self) -> impl Iterator<Item = Block<'_>> {
+        std::iter::once(Block::Slots(&self.clearance))
+    }
+    fn blocks_mut(&mut self) -> impl Iterator<Item = BlockMut<'_>> {
+        std::iter::once(BlockMut::Slots(&mut self.clearance))
+    }
+}
+
+/// A flat plan (`3 h + c`) as thrusts per sample.
+#[must_use]
+pub fn tug_inputs(plan: &[f64]) -> [TugInput; HORIZON] {
+    std::array::from_fn(|h| std::array::from_fn(|c| plan[3 * h + c]))
+}
+
+impl TugProblem {
+    /// The problem for `model`.
+    #[must_use]
+    pub fn new(model: TugModel, params: TugMpcParams) -> TugProblem {
+        TugProblem {
+            space: InputSpace::new(params.channels().to_vec(), HORIZON),
             model,
             params,
-            variants,
-            trust: TrustRegion::new(params.scp),
-            plan: [[0.0; 3]; HORIZON],
-            candidate: [[0.0; 3]; HORIZON],
-            lin: [TugLinearisation::default(); HORIZON],
-            lin_key: None,
-            sens: [[Matrix6x3::zeros(); HORIZON]; HORIZON],
-            states: [[0.0; 6]; HORIZON],
-            candidate_states: [[0.0; 6]; HORIZON],
-            quad: QuadModel::new(N),
-        })
-    }
-
-    /// The current plan.
-    #[must_use]
-    pub fn plan(&self) -> &[TugInput; HORIZON] {
-        &self.plan
-    }
-
-    /// Replaces the plan (warm start); it is clamped to the bounds at the next step.
-    pub fn set_plan(&mut self, plan: [TugInput; HORIZON]) {
-        self.plan = plan;
-    }
-
-    /// The predicted states of the plan as of the last step (`g_i`: the pose part).
-    #[must_use]
-    pub fn predicted_states(&self) -> &[TugState; HORIZON] {
-        &self.states
-    }
-
-    /// The trust region.
-    #[must_use]
-    pub fn trust_region(&self) -> &TrustRegion {
-        &self.trust
-    }
-
-    /// The trust region, to reset it (e.g. at a new sample).
-    pub fn trust_region_mut(&mut self) -> &mut TrustRegion {
-        &mut self.trust
+        }
     }
 
     /// The prediction model.
@@ -200,113 +161,111 @@ impl TugMpc {
     pub fn params(&self) -> &TugMpcParams {
         &self.params
     }
+}
 
-    /// The true cost of `plan` for `data` (nonlinear rollout).
-    #[must_use]
-    pub fn cost(&self, plan: &[TugInput; HORIZON], data: &TugStepData<'_>) -> f64 {
-        let states = self.model.rollout(&data.state, plan, &data.pulls);
-        let mut quad = QuadModel::new(0);
-        quad.reset(true);
-        accumulate(&mut quad, &self.params, &states, None, None, data);
-        quad.value
+impl Subproblem for TugProblem {
+    type Data<'a> = TugStepData<'a>;
+    type Trajectory = [TugState; HORIZON];
+    type Linearisation = TugLinearised;
+    type Key = (TugState, [TowlinePull; HORIZON]);
+    type Rows = TugRows;
+    type Cost = f64;
+
+    fn space(&self) -> &InputSpace {
+        &self.space
     }
 
-    /// One SCP step (module docs). Allocation-free.
-    pub fn solve_step(&mut self, data: &TugStepData<'_>) -> ScpReport {
-        let lim = self.params.thrust_limit;
-        for tau in &mut self.plan {
-            for (t, l) in tau.iter_mut().zip(lim) {
-                *t = t.clamp(-l, l);
-            }
+    fn rows(&self) -> TugRows {
+        TugRows {
+            clearance: self.params.clearance.rows(3),
         }
-        let key = (data.state, self.plan, data.pulls);
-        if self.lin_key != Some(key) {
-            self.model.linearise_thrust_rollout_into(
-                &data.state,
-                &self.plan,
-                &data.pulls,
-                &mut self.lin,
-            );
-            condense(
-                std::array::from_fn(|h| &self.lin[h].a),
-                std::array::from_fn(|h| &self.lin[h].b),
-                &mut self.sens,
-            );
-            self.lin_key = Some(key);
-        }
-        for h in 0..HORIZON {
-            self.states[h] = self.lin[h].x_next;
-        }
-        self.quad.reset(false);
-        let full = self.variants.len() - 1;
-        self.variants[full].1.clear();
-        accumulate(
-            &mut self.quad,
-            &self.params,
-            &self.states,
-            Some(&self.sens),
-            Some(&mut self.variants[full].1),
-            data,
-        );
-        let radius = self.trust.radius();
-        let (mut lo, mut hi) = ([0.0; N], [0.0; N]);
-        for h in 0..HORIZON {
-            for c in 0..3 {
-                let tr = radius * self.params.trust_scale[c];
-                let u = self.plan[h][c];
-                lo[3 * h + c] = (-lim[c] - u).max(-tr);
-                hi[3 * h + c] = (lim[c] - u).min(tr);
-            }
-        }
-        let used = load_layout(&mut self.variants, tug_layout, &self.quad, &lo, &hi);
-        let cost_before = self.quad.value;
-        let (qp, rows) = &mut self.variants[used];
-        let (outcome, iterations, predicted) =
-            match solve_layout(qp, rows, &self.quad, N, &mut self.trust) {
-                Ok(solved) => solved,
-                Err(report) => return report,
-            };
-        let du = qp.solution();
-        for h in 0..HORIZON {
-            for c in 0..3 {
-                self.candidate[h][c] = (self.plan[h][c] + du[3 * h + c]).clamp(-lim[c], lim[c]);
-            }
-        }
-        self.model.rollout_into(
-            &data.state,
-            &self.candidate,
-            &data.pulls,
-            &mut self.candidate_states,
-        );
-        self.quad.reset(true);
-        accumulate(
-            &mut self.quad,
-            &self.params,
-            &self.candidate_states,
-            None,
-            None,
-            data,
-        );
-        let cost_candidate = self.quad.value;
-        let (accepted, ratio) = self.trust.judge(cost_before, cost_candidate, predicted);
-        if accepted {
-            self.plan = self.candidate;
-            self.states = self.candidate_states;
-        }
-        ScpReport::judged(
-            outcome,
-            [cost_before, cost_candidate, predicted],
-            accepted,
-            ratio,
-            self.trust.radius(),
-            iterations,
+    }
+
+    fn buffers(&self) -> (Self::Trajectory, TugLinearised) {
+        (
+            [[0.0; 6]; HORIZON],
+            TugLinearised {
+                steps: [TugLinearisation::default(); HORIZON],
+                sens: [[Matrix6x3::zeros(); HORIZON]; HORIZON],
+                states: [[0.0; 6]; HORIZON],
+            },
         )
+    }
+
+    /// No rate bounds: the previous command does not matter.
+    fn previous(&self, _data: &TugStepData<'_>, out: &mut [f64]) {
+        out.fill(0.0);
+    }
+
+    fn key(&self, data: &TugStepData<'_>) -> Self::Key {
+        (data.state, data.pulls)
+    }
+
+    fn rollout(&self, data: &TugStepData<'_>, plan: &[f64], out: &mut Self::Trajectory) {
+        self.model
+            .rollout_into(&data.state, &tug_inputs(plan), &data.pulls, out);
+    }
+
+    fn linearise(&self, data: &TugStepData<'_>, plan: &[f64], lin: &mut TugLinearised) {
+        self.model.linearise_thrust_rollout_into(
+            &data.state,
+            &tug_inputs(plan),
+            &data.pulls,
+            &mut lin.steps,
+        );
+        condense(
+            std::array::from_fn(|h| &lin.steps[h].a),
+            std::array::from_fn(|h| &lin.steps[h].b),
+            &mut lin.sens,
+        );
+        for h in 0..HORIZON {
+            lin.states[h] = lin.steps[h].x_next;
+        }
+    }
+
+    fn nominal(lin: &TugLinearised) -> &Self::Trajectory {
+        &lin.states
+    }
+
+    fn terms(
+        &self,
+        quad: &mut QuadModel,
+        traj: &Self::Trajectory,
+        _plan: &[f64],
+        model: Option<(&TugLinearised, &mut TugRows)>,
+        data: &TugStepData<'_>,
+    ) -> f64 {
+        let (sens, clearance) = match model {
+            Some((lin, rows)) => (Some(&lin.sens), Some(&mut rows.clearance)),
+            None => (None, None),
+        };
+        accumulate(quad, &self.params, traj, sens, clearance, data);
+        quad.value
     }
 }
 
-/// A tug layout's QP and clearance rows.
-fn tug_layout(v: &mut (Qp, Clearance)) -> (&mut Qp, &mut Clearance) {
-    (&mut v.0, &mut v.1)
+/// A tug's local MPC: the SCP engine over [`TugProblem`].
+pub type TugMpc = Scp<TugProblem>;
+
+impl Scp<TugProblem> {
+    /// The problem for `model`, the plan at zero thrust.
+    ///
+    /// # Errors
+    /// A QP that cannot be built.
+    pub fn new(model: TugModel, params: TugMpcParams) -> Result<TugMpc, QpBuildError> {
+        Scp::with_problem(TugProblem::new(model, params), params.scp)
+    }
+
+    /// The plan as thrusts per sample.
+    #[must_use]
+    pub fn inputs(&self) -> [TugInput; HORIZON] {
+        tug_inputs(self.plan())
+    }
+
+    /// Replaces the plan (warm start); it is clamped to the bounds at the next step.
+    pub fn set_inputs(&mut self, plan: [TugInput; HORIZON]) {
+        self.set_plan(plan.as_flattened());
+    }
 }
 
 /// The cost terms of the states `states` (after samples 0..H); with `sens` the
@@ -316,7 +275,7 @@ fn accumulate(
     params: &TugMpcParams,
     states: &[TugState; HORIZON],
     sens: Option<&[[Matrix6x3<f64>; HORIZON]; HORIZON]>,
-    mut clearance: Option<&mut Clearance>,
+    mut clearance: Option<&mut SlotRows>,
     data: &TugStepData<'_>,
 ) {
     let [w1, w2, w3] = params.weights;
@@ -385,8 +344,8 @@ mod tests {
     }
 
     fn within_bounds(mpc: &TugMpc) -> bool {
-        let lim = mpc.params().thrust_limit;
-        mpc.plan()
+        let lim = mpc.problem().params().thrust_limit;
+        mpc.inputs()
             .iter()
             .all(|t| t.iter().zip(lim).all(|(v, l)| v.abs() <= l + 1e-9))
     }
@@ -396,12 +355,12 @@ mod tests {
         let mut mpc = tug_mpc();
         let data = data_ahead(&[]);
         // Start from a poor plan (sway and yaw thrust): several nonlinear steps.
-        mpc.set_plan([[0.0, 8.0, -5.0]; HORIZON]);
+        mpc.set_inputs([[0.0, 8.0, -5.0]; HORIZON]);
         let initial = mpc.cost(mpc.plan(), &data);
         let mut last = initial;
         let mut accepted = 0;
         for _ in 0..30 {
-            let report = mpc.solve_step(&data);
+            let report = mpc.step(&data);
             assert!(report.qp.is_usable(), "{report:?}");
             assert!(within_bounds(&mpc));
             // The true cost never rises; it falls on accepted steps.
@@ -418,10 +377,10 @@ mod tests {
         assert!(accepted >= 2, "{accepted}");
         assert!(last < 0.5 * initial, "{last} vs {initial}");
         // The first move pushes the tug forward.
-        assert!(mpc.plan()[0][0] > 0.5, "{:?}", mpc.plan());
-        assert!(mpc.predicted_states()[HORIZON - 1][0] > 0.1);
+        assert!(mpc.inputs()[0][0] > 0.5, "{:?}", mpc.inputs());
+        assert!(mpc.predicted()[HORIZON - 1][0] > 0.1);
         // Converged: one more step changes (almost) nothing.
-        let report = mpc.solve_step(&data);
+        let report = mpc.step(&data);
         assert!(report.cost_before - report.cost_after <= 1e-4 * report.cost_before.max(1.0));
     }
 
@@ -435,10 +394,10 @@ mod tests {
         let mut with_lambda = data;
         with_lambda.lambda = [[2.0, 0.0, 0.0]; HORIZON];
         for _ in 0..30 {
-            free.solve_step(&data);
-            priced.solve_step(&with_lambda);
+            free.step(&data);
+            priced.step(&with_lambda);
         }
-        assert!(priced.plan()[0][0] < free.plan()[0][0]);
+        assert!(priced.inputs()[0][0] < free.inputs()[0][0]);
     }
 
     /// An obstacle just ahead of the reference holds the tug back.
@@ -453,13 +412,11 @@ mod tests {
         let data = data_ahead(&[]);
         let data_obs = data_ahead(&obstacles);
         for _ in 0..30 {
-            free.solve_step(&data);
-            let r = blocked.solve_step(&data_obs);
+            free.step(&data);
+            let r = blocked.step(&data_obs);
             assert!(within_bounds(&blocked) && r.qp.is_usable());
         }
-        assert!(
-            blocked.predicted_states()[HORIZON - 1][0] < free.predicted_states()[HORIZON - 1][0]
-        );
+        assert!(blocked.predicted()[HORIZON - 1][0] < free.predicted()[HORIZON - 1][0]);
     }
 
     /// Scheme II (no distance cost): an obstacle between the tug and its
@@ -488,13 +445,13 @@ mod tests {
             data.reference = [[1.5, 0.0, 0.0]; HORIZON];
             let mut last = f64::INFINITY;
             for _ in 0..40 {
-                let report = mpc.solve_step(&data);
+                let report = mpc.step(&data);
                 assert!(report.qp.is_usable(), "{report:?}");
                 assert!(within_bounds(&mpc));
                 assert!(report.cost_after <= last);
                 last = report.cost_after;
             }
-            mpc.predicted_states()
+            mpc.predicted()
                 .iter()
                 .map(|x| obstacles[0].distance([x[0], x[1]]).0)
                 .fold(f64::INFINITY, f64::min)

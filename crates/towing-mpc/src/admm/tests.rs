@@ -124,13 +124,10 @@ fn rho_sweep() {
 
 /// The next sample's input if the plant did what the prediction says.
 fn plant_like_next<'a>(a: &Admm, input: &SampleInput<'a>, r: &AdmmReport) -> SampleInput<'a> {
-    let ship = a.ship().predicted_states()[0];
+    let ship = a.ship().predicted()[0];
     SampleInput {
         ship,
-        tugs: [
-            a.tug(0).predicted_states()[0],
-            a.tug(1).predicted_states()[0],
-        ],
+        tugs: [a.tug(0).predicted()[0], a.tug(1).predicted()[0]],
         previous: AppliedCommand {
             ship: [r.tension[0], r.tension[1], r.angle[0], r.angle[1]],
             tugs: r.tug_thrust,
@@ -278,7 +275,7 @@ fn converges_on_a_displaced_instance() {
 }
 
 fn check_bounds(a: &Admm, r: &AdmmReport, previous: &AppliedCommand) {
-    let sp = *a.ship().params();
+    let sp = *a.ship().problem().params();
     let tol = 1e-9;
     let mut before = previous.ship;
     for k in 0..2 {
@@ -286,8 +283,8 @@ fn check_bounds(a: &Admm, r: &AdmmReport, previous: &AppliedCommand) {
         before[2 + k] = before[2 + k].clamp(-sp.max_angle, sp.max_angle);
     }
     let first = [r.tension[0], r.tension[1], r.angle[0], r.angle[1]];
-    assert_eq!(first, a.ship().plan()[0]);
-    for u in a.ship().plan() {
+    assert_eq!(first, a.ship().inputs()[0]);
+    for u in &a.ship().inputs() {
         for k in 0..2 {
             assert!(
                 u[k] >= sp.min_tension - tol && u[k] <= sp.max_tension + tol,
@@ -307,9 +304,9 @@ fn check_bounds(a: &Admm, r: &AdmmReport, previous: &AppliedCommand) {
         before = *u;
     }
     for i in 0..2 {
-        assert_eq!(r.tug_thrust[i], a.tug(i).plan()[0]);
-        let lim = a.tug(i).params().thrust_limit;
-        for tau in a.tug(i).plan() {
+        assert_eq!(r.tug_thrust[i], a.tug(i).inputs()[0]);
+        let lim = a.tug(i).problem().params().thrust_limit;
+        for tau in &a.tug(i).inputs() {
             for c in 0..3 {
                 assert!(tau[c].abs() <= lim[c] + tol, "{tau:?}");
             }

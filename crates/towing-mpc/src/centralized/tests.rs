@@ -96,12 +96,12 @@ fn tight_settings() -> CentralizedSettings {
 /// state and a plan away from the kinks.
 #[test]
 fn jacobians_match_finite_differences() {
-    let mut c = centralized(CentralizedSettings::default());
+    let c = centralized(CentralizedSettings::default());
     let mut input = instance(2.0, 0.3, 0.1, 0.1);
     input.ship[3..].copy_from_slice(&[0.15, 0.02, 0.01]);
     input.tugs[0][3..].copy_from_slice(&[0.12, -0.03, 0.02]);
     input.tugs[1][3..].copy_from_slice(&[0.18, 0.04, -0.015]);
-    c.plan = Plan {
+    let plan = Plan {
         ship: [
             [1.2, 1.8, 0.1, -0.05],
             [1.0, 2.0, 0.12, -0.08],
@@ -112,55 +112,57 @@ fn jacobians_match_finite_differences() {
             [[2.0, -0.7, 0.4], [1.7, 0.3, -0.2], [2.2, 0.1, 0.3]],
         ],
     };
-    let start = Start::of(&input);
-    c.linearise(&start);
-    // The residuals g - f along a plan.
-    let residuals = |c: &Centralized, plan: &Plan| {
-        let mut traj = c.traj;
-        c.problem.rollout(&start, plan, &mut traj);
-        let mut quad = QuadModel::new(0);
-        quad.reset(true);
-        let mut cons = c.cons.clone();
-        c.problem
-            .accumulate(&mut quad, &traj, plan, None, &mut cons, &input);
-        (traj, cons.r)
+    let problem = c.scp.problem();
+    let data = CentralData::of(&input);
+    let (_, mut lin) = problem.buffers();
+    let mut flat = [0.0; NU];
+    plan.write(&mut flat);
+    problem.linearise(&data, &flat, &mut lin);
+    // The trajectories and the residuals g - f along a plan (read off a
+    // linearised evaluation: value-only terms record no rows).
+    let residuals = |plan: &Plan| {
+        let mut flat = [0.0; NU];
+        plan.write(&mut flat);
+        let mut rows = problem.rows();
+        let mut r = [0.0; NC];
+        let (_, mut l) = problem.buffers();
+        problem.linearise(&data, &flat, &mut l);
+        let mut q = QuadModel::new(NU);
+        q.reset(false);
+        problem.terms(&mut q, &l.traj, &flat, Some((&l, &mut rows)), &data);
+        for (m, v) in r.iter_mut().enumerate() {
+            *v = rows.consensus.value(m);
+        }
+        (l.traj, r)
     };
     // Consensus rows at the linearisation point.
     let mut quad = QuadModel::new(NU);
     quad.reset(false);
-    let mut clr = c.layouts[0].clearance.clone();
-    let mut cons = c.cons.clone();
-    c.problem.accumulate(
-        &mut quad,
-        &c.traj,
-        &c.plan,
-        Some((&c.sens, &mut clr)),
-        &mut cons,
-        &input,
-    );
+    let mut rows = problem.rows();
+    problem.terms(&mut quad, &lin.traj, &flat, Some((&lin, &mut rows)), &data);
     let eps = 1e-6;
     let mut worst: f64 = 0.0;
     let mut worst_cross: f64 = 0.0;
     for v in 0..NU {
         let perturbed = |delta: f64| {
-            let mut p = c.plan;
+            let mut p = plan;
             let (h, k) = (v / PER_STEP, v % PER_STEP);
             if k < 4 {
                 p.ship[h][k] += delta;
             } else {
                 p.tugs[(k - 4) / 3][h][(k - 4) % 3] += delta;
             }
-            residuals(&c, &p)
+            residuals(&p)
         };
         let ((tp, rp), (tm, rm)) = (perturbed(eps), perturbed(-eps));
         let fd = |a: f64, b: f64| (a - b) / (2.0 * eps);
         for h in 0..HORIZON {
             for r in 0..6 {
-                let e = (fd(tp.ship[h][r], tm.ship[h][r]) - c.sens.ship[h][(r, v)]).abs();
+                let e = (fd(tp.ship[h][r], tm.ship[h][r]) - lin.sens.ship[h][(r, v)]).abs();
                 worst = worst.max(e);
                 for i in 0..2 {
                     let want = fd(tp.tugs[i][h][r], tm.tugs[i][h][r]);
-                    let e = (want - c.sens.tugs[i][h][(r, v)]).abs();
+                    let e = (want - lin.sens.tugs[i][h][(r, v)]).abs();
                     worst = worst.max(e);
                     if v % PER_STEP < 4 {
                         worst_cross = worst_cross.max(want.abs());
@@ -169,7 +171,7 @@ fn jacobians_match_finite_differences() {
             }
         }
         for m in 0..NC {
-            let e = (fd(rp[m], rm[m]) - cons.rows[m][v]).abs();
+            let e = (fd(rp[m], rm[m]) - rows.consensus.gradient(m)[v]).abs();
             worst = worst.max(e);
         }
     }
@@ -198,14 +200,14 @@ fn compare_print() {
             let ra = a.solve_sample(&input);
             let b = c.evaluate(
                 &input,
-                a.ship().plan(),
-                &[*a.tug(0).plan(), *a.tug(1).plan()],
+                &a.ship().inputs(),
+                &[a.tug(0).inputs(), a.tug(1).inputs()],
             );
             eprintln!(
                 "   admm rho {rho}: it {} conv {} r_pri {:?} cost {:.6} {:?} first F {:?} a {:?} tau {:?}",
                 ra.iterations, ra.converged, ra.r_pri, b.total(), b, ra.tension, ra.angle, ra.tug_thrust
             );
-            eprintln!("      plan {:?}", a.ship().plan());
+            eprintln!("      plan {:?}", a.ship().inputs());
         }
     }
 }
@@ -315,8 +317,8 @@ fn distributed_matches_centralized() {
         assert!(ra.history()[0].r_pri[1] > 100.0 * ra.r_pri[1], "{name}");
         let b = c.evaluate(
             &input,
-            a.ship().plan(),
-            &[*a.tug(0).plan(), *a.tug(1).plan()],
+            &a.ship().inputs(),
+            &[a.tug(0).inputs(), a.tug(1).inputs()],
         );
         assert!(b.consensus_max < 1e-4, "{name}: {b:?}");
         let (jc, ja) = (rc.breakdown.total(), b.total());

@@ -1,0 +1,270 @@
+//! The cost terms the subproblems share, each written once: the ship's stage
+//! terms of eq. (13) (with the regularisers, the terminal term and the one-sided
+//! heading term of `docs/assumptions.md`), the obstacle terms (the distance cost
+//! `phi` of eq. (13)-(14) and the hard clearance rows of the design document),
+//! the tugs' move suppression of the centralized problem, and the heading
+//! difference. A term feeds the [`QuadModel`] with its value and, where the
+//! subproblem linearises, its rows `dr/du` over the step's increments.
+//!
+//! Rows: `rows[c]` is `d x_c / du` of a predicted state `x = [x, y, psi, u, v, r]`
+//! over the QP's increments (zero where the state does not depend on an
+//! increment); a value-only evaluation passes zero rows.
+
+use crate::engine::{QuadModel, SlotRows};
+use crate::obstacle::{DistanceCost, Obstacle};
+use crate::ship::{ShipInput, ShipState};
+use crate::ship_mpc::ShipMpcParams;
+use crate::tug::TugInput;
+use crate::HORIZON;
+
+/// `a - b` wrapped to `(-pi, pi]` (heading differences).
+#[must_use]
+pub fn angle_difference(a: f64, b: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    let d = (a - b).rem_euclid(TAU);
+    if d > PI {
+        d - TAU
+    } else {
+        d
+    }
+}
+
+/// The hard clearance constraint of the design document, linearised, with an
+/// exact L1 penalty on its slack (a [`SlotRows`] block, one slot per obstacle):
+///
+/// ```text
+/// d_j(x_{h+1}) + (dd_j/du) du >= d_min - s_hj,   0 <= s_hj <= s_max,   cost += W s_hj
+/// ```
+///
+/// one row and one slack per sample and obstacle slot. `d` is the distance of
+/// [`crate::Obstacle::distance`] (from the obstacle's boundary, focal distance for
+/// an ellipse, so `d >= d_min` keeps the vessel's centre outside the circle grown
+/// by `d_min`, or the confocal ellipse with semi-major axis `a + d_min`), `d_min`
+/// the own hull clearance (about half the own length). The penalty
+/// `W max(0, d_min - d)` is part of the true cost, so the SCP merit is the exact
+/// penalty function. Only the first `max_obstacles` obstacles get rows (all of
+/// them enter the distance cost `phi`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClearanceParams {
+    /// Obstacle slots (rows per sample), fixed at construction.
+    pub max_obstacles: usize,
+    /// `d_min` (m).
+    pub min_distance: f64,
+    /// `W`: L1 penalty on the slack (per m).
+    pub penalty: f64,
+    /// Upper bound of a slack (m); keeps the QP bounded.
+    pub max_slack: f64,
+}
+
+impl ClearanceParams {
+    /// `max_obstacles = 4`, `W = 1e4`, `s_max = 10 m`, the given `d_min`.
+    #[must_use]
+    pub fn with_min_distance(min_distance: f64) -> ClearanceParams {
+        ClearanceParams {
+            max_obstacles: 4,
+            min_distance,
+            penalty: 1e4,
+            max_slack: 10.0,
+        }
+    }
+
+    /// The penalty term of the true cost at distance `d`.
+    #[must_use]
+    pub fn penalty_at(&self, d: f64) -> f64 {
+        self.penalty * (self.min_distance - d).max(0.0)
+    }
+
+    /// The block of rows over `per_step` increments per sample.
+    #[must_use]
+    pub fn rows(&self, per_step: usize) -> SlotRows {
+        SlotRows::new(
+            self.max_obstacles,
+            HORIZON,
+            per_step,
+            self.penalty,
+            self.max_slack,
+        )
+    }
+}
+
+/// The obstacle terms of one predicted position `pos` (the state after sample
+/// `h`; moving obstacles as predicted then, [`Obstacle::after`]) with
+/// `d(x, y)/du = (row_x, row_y)`: the distance cost `w phi(d)` of every obstacle
+/// and, for the first `params.max_obstacles`, the clearance penalty and (with
+/// `clearance`) the linearised row.
+#[allow(clippy::too_many_arguments)] // the pieces of one term; three call sites
+pub(crate) fn obstacle_terms<const N: usize>(
+    quad: &mut QuadModel,
+    obstacles: &[Obstacle],
+    distance: &DistanceCost,
+    w: f64,
+    params: &ClearanceParams,
+    mut clearance: Option<&mut SlotRows>,
+    h: usize,
+    pos: [f64; 2],
+    row_x: &[f64; N],
+    row_y: &[f64; N],
+) {
+    for (j, obstacle) in obstacles.iter().enumerate() {
+        let (d, grad) = obstacle.after(h + 1).distance(pos);
+        let (phi, slope, curvature) = distance.eval(d);
+        let mut row = [0.0; N];
+        for (r, (a, b)) in row.iter_mut().zip(row_x.iter().zip(row_y)) {
+            *r = grad[0] * a + grad[1] * b;
+        }
+        quad.curved(phi, slope, curvature, w, &row);
+        if j < params.max_obstacles {
+            quad.value += params.penalty_at(d);
+            if let Some(c) = clearance.as_deref_mut() {
+                c.record(h, j, d, params.min_distance, &row);
+            }
+        }
+    }
+}
+
+/// The ship's own terms of eq. (13) at one predicted state `x` (after sample
+/// `h`) reached with the sample's input `u`, shared by the coordination and the
+/// centralized problems: `w_S1 |eta - eta_d|^2` (heading wrapped), the velocity
+/// term (`w_S2`, the yaw rate optionally weighted apart), the optional
+/// regularisers of the tensions and angles, the one-sided heading term below a
+/// COLREGS heading floor and, on the last sample, the optional terminal term.
+/// `rows[c]` is `d x_c / du` over the QP's variables, `columns` the QP columns of
+/// `u` (`None`: value only).
+#[allow(clippy::too_many_arguments)] // the pieces of one stage; two call sites
+pub(crate) fn ship_stage_terms<const N: usize>(
+    quad: &mut QuadModel,
+    params: &ShipMpcParams,
+    x: &ShipState,
+    reference: [f64; 3],
+    u: &ShipInput,
+    rows: &[[f64; N]; 6],
+    columns: Option<[usize; 4]>,
+    last: bool,
+    heading_floor: Option<f64>,
+) {
+    let [w1, w2, _] = params.weights;
+    if let Some(floor) = heading_floor {
+        // One-sided: zero (with its gradient) at or to starboard of the floor.
+        let e = angle_difference(x[2], floor);
+        if e < 0.0 {
+            quad.curved(e * e, 2.0 * e, 2.0, params.port_turn_weight, &rows[2]);
+        }
+    }
+    let err = [
+        x[0] - reference[0],
+        x[1] - reference[1],
+        angle_difference(x[2], reference[2]),
+    ];
+    let wv = [w2, w2, params.yaw_rate_weight.unwrap_or(w2)];
+    for c in 0..3 {
+        quad.residual(err[c], w1, 0.0, &rows[c]);
+        quad.residual(x[3 + c], wv[c], 0.0, &rows[3 + c]);
+    }
+    let wu = [
+        params.tension_weight,
+        params.tension_weight,
+        params.angle_weight,
+        params.angle_weight,
+    ];
+    for (k, w) in wu.into_iter().enumerate() {
+        if w > 0.0 {
+            let mut row = [0.0; N];
+            if let Some(cols) = columns {
+                row[cols[k]] = 1.0;
+            }
+            quad.residual(u[k], w, 0.0, &row);
+        }
+    }
+    if let (true, Some(t)) = (last, params.terminal) {
+        terminal_terms(quad, t.weight, t.horizon, x, &err, rows);
+    }
+}
+
+/// The terminal term `w |e_H + tau eta_dot_H|^2` ([`crate::TerminalCost`]): the
+/// pose error `err` extrapolated `tau` seconds with the predicted velocity over
+/// ground `eta_dot = R(psi) nu` (Fossen 2021, eq. (2.19)).
+fn terminal_terms<const N: usize>(
+    quad: &mut QuadModel,
+    weight: f64,
+    tau: f64,
+    x: &ShipState,
+    err: &[f64; 3],
+    rows: &[[f64; N]; 6],
+) {
+    let (sn, cs) = x[2].sin_cos();
+    let xdot = [cs * x[3] - sn * x[4], sn * x[3] + cs * x[4], x[5]];
+    // d eta_dot / d(psi, u, v, r).
+    let d_psi = [-sn * x[3] - cs * x[4], cs * x[3] - sn * x[4], 0.0];
+    let d_nu = [[cs, -sn, 0.0], [sn, cs, 0.0], [0.0, 0.0, 1.0]];
+    for c in 0..3 {
+        let mut row = [0.0; N];
+        for (v, slot) in row.iter_mut().enumerate() {
+            *slot = rows[c][v]
+                + tau
+                    * (d_psi[c] * rows[2][v]
+                        + d_nu[c][0] * rows[3][v]
+                        + d_nu[c][1] * rows[4][v]
+                        + d_nu[c][2] * rows[5][v]);
+        }
+        quad.residual(err[c] + tau * xdot[c], weight, 0.0, &row);
+    }
+}
+
+/// `w sum_h |tau_h - tau_h-1|^2` over one tug's plan, `tau_-1 = previous`, with
+/// `column(h, c)` the increment variable of channel `c` of sample `h` (the
+/// variables are increments of the plan, so the rows are unit vectors).
+///
+/// Why, and why only in the centralized problem: there the configuration
+/// restriction `g_i = f_i` holds at every sample, three equalities per sample
+/// against a tug's three thrusts, so the tugs' thrusts are slaved to the ship's
+/// plan, and the cost of (16) has no input term. A TitoNeri's sway force and
+/// yaw moment have a combination that barely moves the pose at the sample
+/// instants of a 3-step horizon; nothing fixed it, and in the closed loop tug
+/// 1's sway thrust alternated in sign from sample to sample and grew from 1.8 N
+/// to 7 N within 40 s, until the tow crept off its destination (scheme III) or
+/// swung to port while giving way (scheme I) (`docs/controller-design.md`).
+/// A move-suppression term is the standard remedy (Maciejowski 2002, Predictive
+/// Control with Constraints, section 3.1, the weight on input changes). The
+/// distributed controller does not need it (the ADMM's penalty `rho` keeps
+/// the consensus soft within an iteration, and no such alternation was seen),
+/// and there it slowed the ADMM's convergence on the paper instance tenfold,
+/// so it is not in the tug problem: with `w > 0` the two architectures solve
+/// problems that differ by this term (`distributed_matches_centralized` sets it
+/// to 0).
+pub(crate) fn thrust_rate_terms<const N: usize>(
+    quad: &mut QuadModel,
+    weight: f64,
+    plan: &[TugInput; HORIZON],
+    previous: TugInput,
+    column: impl Fn(usize, usize) -> usize,
+) {
+    if weight <= 0.0 {
+        return;
+    }
+    for h in 0..HORIZON {
+        let before = if h == 0 { previous } else { plan[h - 1] };
+        for c in 0..3 {
+            let mut row = [0.0; N];
+            if !quad.value_only {
+                row[column(h, c)] = 1.0;
+                if h > 0 {
+                    row[column(h - 1, c)] = -1.0;
+                }
+            }
+            quad.residual(plan[h][c] - before[c], weight, 0.0, &row);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn angle_difference_wraps() {
+        use std::f64::consts::PI;
+        assert!((angle_difference(PI - 0.1, -PI + 0.1) + 0.2).abs() < 1e-12);
+        assert!((angle_difference(0.3, 0.1) - 0.2).abs() < 1e-12);
+        assert!((angle_difference(7.0, 0.0) - (7.0 - 2.0 * PI)).abs() < 1e-12);
+    }
+}

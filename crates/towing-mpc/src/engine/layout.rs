@@ -1,0 +1,144 @@
+//! The QPs of one subproblem: one per number of soft-row slots per sample in
+//! use, built at construction and updated in place.
+//!
+//! Variables: the increments, then each block's slacks in block order. Rows: two
+//! box rows per variable (`2 j`: `x_j <= hi_j`, `2 j + 1`: `-x_j <= -lo_j`), then
+//! the rate rows, then each block's rows. `P` is dense over the increments and
+//! zero over the slacks. A step uses the smallest layout that holds the slots
+//! recorded (an unused slot is a row `-s <= 0` on a slack of positive cost: its
+//! slack is zero at the optimum, so a layout without it has the same solution in
+//! the increments, and fewer rows).
+
+use super::quad::QuadModel;
+use super::rows::{self, set_box, BlockLayout, RowSet};
+use super::space::InputSpace;
+use crate::qp::{Pattern, Qp, QpBuildError, QpOutcome};
+
+/// One QP layout.
+#[derive(Debug)]
+pub(crate) struct Layout {
+    qp: Qp,
+    /// First rate row.
+    rate_row: usize,
+    blocks: Vec<BlockLayout>,
+}
+
+impl Layout {
+    /// The layout of `rows` with `slots` slots per sample.
+    fn new(space: &InputSpace, rows: &impl RowSet, slots: usize) -> Result<Layout, QpBuildError> {
+        let n_u = space.len();
+        let rate = space.rate_entries(0);
+        let n_rate = rate.len();
+        let mut entries: Vec<(usize, usize)> = rate.iter().map(|(e, _)| *e).collect();
+        let placed = rows::layout_entries(rows, slots, space.rate_rows(), n_u);
+        let n = placed.variables;
+        entries.extend(placed.entries);
+        let (mut qp, a_slots) = box_qp(n, n_u, placed.rows, &entries)?;
+        for (slot, (_, v)) in a_slots[..n_rate].iter().zip(&rate) {
+            qp.a_mut()[*slot] = *v;
+        }
+        let rate_row = 2 * n;
+        let blocks = rows::block_layouts(rows, &placed.sizes, &a_slots[n_rate..], rate_row);
+        Ok(Layout {
+            qp,
+            rate_row,
+            blocks,
+        })
+    }
+
+    /// Solves the loaded QP: the outcome, Clarabel's iterations and the decrease
+    /// the quadratic model and the soft rows predict for the solution; or the
+    /// failed outcome and its iterations.
+    pub(crate) fn solve(
+        &mut self,
+        rows: &impl RowSet,
+        quad: &QuadModel,
+        n_u: usize,
+    ) -> Result<(QpOutcome, u32, f64), (QpOutcome, u32)> {
+        let outcome = self.qp.solve();
+        let iterations = self.qp.iterations();
+        if !outcome.is_usable() {
+            return Err((outcome, iterations));
+        }
+        let x = self.qp.solution();
+        let mut predicted = quad.predicted_decrease(&x[..n_u]);
+        rows::add_predicted_decrease(rows, &self.blocks, x, n_u, &mut predicted);
+        Ok((outcome, iterations, predicted))
+    }
+
+    /// The QP.
+    pub(crate) fn qp(&self) -> &Qp {
+        &self.qp
+    }
+}
+
+/// The layouts of a subproblem, by slots per sample, and the one last used.
+#[derive(Debug)]
+pub(crate) struct Layouts {
+    layouts: Vec<Layout>,
+    used: usize,
+}
+
+impl Layouts {
+    /// One layout per slot count `0..=rows.max_slots()`.
+    pub(crate) fn new(space: &InputSpace, rows: &impl RowSet) -> Result<Layouts, QpBuildError> {
+        let layouts = (0..=rows.max_slots())
+            .map(|c| Layout::new(space, rows, c))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Layouts { layouts, used: 0 })
+    }
+
+    /// Loads one step: drops the soft rows the boxes `[lo, hi]` imply, picks the
+    /// smallest layout holding the rest and writes the quadratic model, the
+    /// boxes, the rate rows (from `plan`) and the soft rows into it.
+    pub(crate) fn load(
+        &mut self,
+        space: &InputSpace,
+        rows: &mut impl RowSet,
+        quad: &QuadModel,
+        plan: &[f64],
+        lo: &[f64],
+        hi: &[f64],
+    ) -> &mut Layout {
+        self.used = rows::prune(rows, lo, hi).min(self.layouts.len() - 1);
+        let layout = &mut self.layouts[self.used];
+        let qp = &mut layout.qp;
+        let n = quad.g.len();
+        qp.p_mut().copy_from_slice(&quad.p);
+        qp.q_mut()[..n].copy_from_slice(&quad.g);
+        qp.q_mut()[n..].fill(0.0);
+        rows::load(rows, &layout.blocks, qp);
+        for (j, (&l, &h)) in lo.iter().zip(hi).enumerate() {
+            set_box(qp, j, l, h);
+        }
+        space.load_rate_rows(qp, layout.rate_row, plan);
+        layout
+    }
+
+    /// The last solution of the layout last loaded (increments then slacks).
+    pub(crate) fn solution(&self) -> &[f64] {
+        self.layouts[self.used].qp().solution()
+    }
+}
+
+/// A QP in `n` variables with a box per variable (rows `2 j`: `x_j <= hi_j`,
+/// `2 j + 1`: `-x_j <= -lo_j`) followed by `extra_rows` rows of the given
+/// entries (row indices counted from 0 after the box). Returns the QP and, per
+/// extra entry, its slot in the value array of `A`. `P` is dense over the first
+/// `n_p` variables and zero over the rest.
+fn box_qp(
+    n: usize,
+    n_p: usize,
+    extra_rows: usize,
+    extra: &[(usize, usize)],
+) -> Result<(Qp, Vec<usize>), QpBuildError> {
+    let mut entries: Vec<(usize, usize)> =
+        (0..n).flat_map(|j| [(2 * j, j), (2 * j + 1, j)]).collect();
+    entries.extend(extra.iter().map(|&(r, c)| (2 * n + r, c)));
+    let (pattern, slots) = Pattern::from_entries(2 * n + extra_rows, n, &entries)?;
+    let mut qp = Qp::with_p_block(pattern, 0, n_p)?;
+    for (k, slot) in slots[..2 * n].iter().enumerate() {
+        qp.a_mut()[*slot] = if k % 2 == 0 { 1.0 } else { -1.0 };
+    }
+    Ok((qp, slots[2 * n..].to_vec()))
+}

@@ -1,0 +1,533 @@
+//! Soft constraints of the step QP: linearised rows whose violation is a slack
+//! variable with an exact L1 penalty (Nocedal and Wright 2006, section 17.2: the
+//! `l1` penalty is exact for a weight above the constraint's multiplier). The QP is
+//! therefore always feasible, the slack is zero whenever the linearised row can be
+//! met, and the penalty `W max(0, violation)` is part of the true merit, so the SCP
+//! judges its steps on the exact penalty function.
+//!
+//! Two kinds, each written once:
+//!
+//! - [`SlotRows`]: one-sided rows `v_k + g_k^T du >= b_k - s_k`, a fixed number of
+//!   *slots* per sample (the clearance to each of the nearest obstacles; any
+//!   one-sided bound of a predicted quantity: a waterway edge, a speed);
+//! - [`PairRows`]: two-sided rows `|r_m + g_m^T du| <= s_m` (a soft equality: the
+//!   centralized problem's configuration restriction).
+//!
+//! A row of sample `h` has entries for the increments of samples `0..=h` only
+//! (causality). The recorded values live in the block, sized for the largest
+//! layout; a [`BlockLayout`] maps them onto one QP. A subproblem lists its blocks
+//! in a [`RowSet`]: a new constraint is a new block in that set, recorded where the
+//! subproblem computes its terms.
+
+use crate::qp::Qp;
+
+/// The QP's slack variable is `SLACK_SCALE s` (m): with the penalty `W = 1e4`
+/// the unscaled slack's cost dominates the QP's scaling and doubles Clarabel's
+/// iterations (measured on the tug problem: 6 without the rows, 11 with them,
+/// 8 to 9 with the scale 100; 1e3 and 1e4 are worse again); scaled, the cost entry is
+/// `W / SLACK_SCALE`.
+pub(crate) const SLACK_SCALE: f64 = 100.0;
+
+/// Sets box `j` (rows `2 j`: `x_j <= hi`, `2 j + 1`: `-x_j <= -lo`) of a step QP.
+pub(crate) fn set_box(qp: &mut Qp, j: usize, lo: f64, hi: f64) {
+    let b = qp.b_mut();
+    b[2 * j] = hi;
+    b[2 * j + 1] = -lo;
+}
+
+/// Where a block's rows, slacks and `A` entries sit in one QP.
+#[derive(Debug, Clone)]
+pub(crate) struct BlockLayout {
+    /// Rows per sample (slot blocks) in this layout.
+    slots: usize,
+    /// First QP row.
+    first_row: usize,
+    /// First slack variable.
+    first_slack: usize,
+    /// `A` value slots, row by row, from `offsets[k]`.
+    a: Vec<usize>,
+    offsets: Vec<usize>,
+}
+
+/// One-sided soft rows with `slots` rows per sample (module docs). Row
+/// `k = h slots + j` is slot `j` of sample `h`.
+#[derive(Debug, Clone)]
+pub struct SlotRows {
+    slots: usize,
+    horizon: usize,
+    per_step: usize,
+    n_u: usize,
+    /// `W` (per unit of the row).
+    penalty: f64,
+    /// Upper bound of a slack (the row's unit); keeps the QP bounded.
+    max_slack: f64,
+    value: Vec<f64>,
+    bound: Vec<f64>,
+    grad: Vec<f64>,
+    active: Vec<bool>,
+}
+
+impl SlotRows {
+    /// `slots` rows per sample over `horizon` samples of `per_step` increments.
+    #[must_use]
+    pub fn new(
+        slots: usize,
+        horizon: usize,
+        per_step: usize,
+        penalty: f64,
+        max_slack: f64,
+    ) -> SlotRows {
+        let n = slots * horizon;
+        let n_u = per_step * horizon;
+        SlotRows {
+            slots,
+            horizon,
+            per_step,
+            n_u,
+            penalty,
+            max_slack,
+            value: vec![0.0; n],
+            bound: vec![0.0; n],
+            grad: vec![0.0; n * n_u],
+            active: vec![false; n],
+        }
+    }
+
+    /// Rows per sample.
+    #[must_use]
+    pub fn slots(&self) -> usize {
+        self.slots
+    }
+
+    /// Forgets the last linearisation.
+    pub fn clear(&mut self) {
+        self.active.fill(false);
+    }
+
+    /// Records slot `j` of sample `h`: `value + row^T du >= bound - s` (`row` over
+    /// the increments; entries beyond them are ignored). Out-of-range slots are
+    /// ignored.
+    pub fn record(&mut self, h: usize, j: usize, value: f64, bound: f64, row: &[f64]) {
+        if j >= self.slots || h >= self.horizon {
+            return;
+        }
+        let k = h * self.slots + j;
+        self.active[k] = true;
+        self.value[k] = value;
+        self.bound[k] = bound;
+        self.grad[k * self.n_u..(k + 1) * self.n_u].copy_from_slice(&row[..self.n_u]);
+    }
+
+    /// Forgets the rows implied by the increments' boxes `[lo_v, hi_v]`: a row
+    /// with `min over the box of g^T du >= b - v` holds at `s = 0` for every
+    /// increment in the box, so its slack (of positive cost, in no other row) is
+    /// zero at the optimum and the row never binds: without it the QP has the same
+    /// solution (and the penalty `W max(0, b - v)` is zero, as is the row's
+    /// predicted decrease).
+    pub fn drop_redundant(&mut self, lo: &[f64], hi: &[f64]) {
+        let n_u = self.n_u;
+        for k in 0..self.active.len() {
+            if !self.active[k] {
+                continue;
+            }
+            let grad = &self.grad[k * n_u..(k + 1) * n_u];
+            let worst: f64 = grad
+                .iter()
+                .zip(lo.iter().zip(hi))
+                .map(|(g, (l, h))| (g * l).min(g * h))
+                .sum();
+            if worst >= self.bound[k] - self.value[k] + 1e-9 {
+                self.active[k] = false;
+            }
+        }
+    }
+
+    /// Slots per sample in use: one more than the highest slot recorded (and
+    /// still active) at any sample; 0 if none.
+    #[must_use]
+    pub fn slots_used(&self) -> usize {
+        let m = self.slots;
+        (0..self.active.len())
+            .filter(|&k| self.active[k])
+            .map(|k| k % m + 1)
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Slots per sample of the layout for `slots` slots (at most this block's).
+    fn layout_slots(&self, slots: usize) -> usize {
+        slots.min(self.slots)
+    }
+
+    /// Increments in the row of layout row `k` (`m` slots per sample).
+    fn width(&self, m: usize, k: usize) -> usize {
+        self.per_step * (k / m.max(1) + 1)
+    }
+
+    /// The recorded row behind layout row `k` of a layout with `m` slots.
+    fn source(&self, m: usize, k: usize) -> usize {
+        (k / m) * self.slots + k % m
+    }
+
+    fn entries(&self, slots: usize, first_row: usize, first_slack: usize) -> Entries {
+        let m = self.layout_slots(slots);
+        let n = m * self.horizon;
+        let mut out = Vec::new();
+        for k in 0..n {
+            for v in 0..self.width(m, k) {
+                out.push((first_row + k, v));
+            }
+            out.push((first_row + k, first_slack + k));
+        }
+        Entries {
+            rows: n,
+            slacks: n,
+            slots: m,
+            entries: out,
+        }
+    }
+
+    /// Writes the rows of `layout` (inactive rows: `-s <= 0`), the slack boxes and
+    /// their costs into `qp`.
+    fn load(&self, layout: &BlockLayout, qp: &mut Qp) {
+        let m = layout.slots;
+        for k in 0..m * self.horizon {
+            let kf = self.source(m, k);
+            let slots = &layout.a[layout.offsets[k]..layout.offsets[k + 1]];
+            let width = self.width(m, k);
+            let active = self.active[kf];
+            let grad = &self.grad[kf * self.n_u..kf * self.n_u + width];
+            let a = qp.a_mut();
+            for (slot, g) in slots.iter().zip(grad) {
+                a[*slot] = if active { -g } else { 0.0 };
+            }
+            a[slots[width]] = -1.0 / SLACK_SCALE;
+            qp.b_mut()[layout.first_row + k] = if active {
+                self.value[kf] - self.bound[kf]
+            } else {
+                0.0
+            };
+            set_box(
+                qp,
+                layout.first_slack + k,
+                0.0,
+                self.max_slack * SLACK_SCALE,
+            );
+            qp.q_mut()[layout.first_slack + k] = self.penalty / SLACK_SCALE;
+        }
+    }
+
+    /// The model's decrease of the penalty for the solution `x` (increments then
+    /// slacks): `W sum (max(0, b - v) - s)` over the active rows.
+    fn predicted_decrease(&self, layout: &BlockLayout, x: &[f64]) -> f64 {
+        let m = layout.slots;
+        (0..m * self.horizon)
+            .filter(|&k| self.active[self.source(m, k)])
+            .map(|k| {
+                let kf = self.source(m, k);
+                self.penalty * (self.bound[kf] - self.value[kf]).max(0.0)
+                    - self.penalty / SLACK_SCALE * x[layout.first_slack + k]
+            })
+            .sum()
+    }
+}
+
+/// Two-sided soft rows `|r_m + g_m^T du| <= s_m` (module docs), each of a given
+/// sample.
+#[derive(Debug, Clone)]
+pub struct PairRows {
+    /// The sample of each row (its causal width).
+    sample: Vec<usize>,
+    per_step: usize,
+    n_u: usize,
+    /// `W` (per unit of the row).
+    penalty: f64,
+    /// Upper bound of a slack.
+    max_slack: f64,
+    value: Vec<f64>,
+    grad: Vec<f64>,
+}
+
+impl PairRows {
+    /// Rows of the given samples, over `n_u = per_step * horizon` increments.
+    #[must_use]
+    pub fn new(
+        sample: Vec<usize>,
+        per_step: usize,
+        horizon: usize,
+        penalty: f64,
+        max_slack: f64,
+    ) -> PairRows {
+        let n = sample.len();
+        let n_u = per_step * horizon;
+        PairRows {
+            sample,
+            per_step,
+            n_u,
+            penalty,
+            max_slack,
+            value: vec![0.0; n],
+            grad: vec![0.0; n * n_u],
+        }
+    }
+
+    /// Records row `m`: residual `r` and `dr/du = row` (over the increments).
+    pub fn record(&mut self, m: usize, r: f64, row: &[f64]) {
+        self.value[m] = r;
+        self.grad[m * self.n_u..(m + 1) * self.n_u].copy_from_slice(&row[..self.n_u]);
+    }
+
+    /// The recorded residual of row `m`.
+    #[must_use]
+    pub fn value(&self, m: usize) -> f64 {
+        self.value[m]
+    }
+
+    /// The recorded `dr/du` of row `m`.
+    #[must_use]
+    pub fn gradient(&self, m: usize) -> &[f64] {
+        &self.grad[m * self.n_u..(m + 1) * self.n_u]
+    }
+
+    fn width(&self, m: usize) -> usize {
+        self.per_step * (self.sample[m] + 1)
+    }
+
+    fn entries(&self, first_row: usize, first_slack: usize) -> Entries {
+        let n = self.sample.len();
+        let mut out = Vec::new();
+        for m in 0..n {
+            for sign in 0..2 {
+                let row = first_row + 2 * m + sign;
+                out.extend((0..self.width(m)).map(|v| (row, v)));
+                out.push((row, first_slack + m));
+            }
+        }
+        Entries {
+            rows: 2 * n,
+            slacks: n,
+            slots: n,
+            entries: out,
+        }
+    }
+
+    /// Rows `r + g^T du - s / SC <= 0` and `-(r + g^T du) - s / SC <= 0`, the slack
+    /// boxes and costs.
+    fn load(&self, layout: &BlockLayout, qp: &mut Qp) {
+        let mut at = 0;
+        for m in 0..self.sample.len() {
+            let width = self.width(m);
+            let grad = &self.grad[m * self.n_u..(m + 1) * self.n_u];
+            for sign in [1.0, -1.0] {
+                let a = qp.a_mut();
+                for v in 0..width {
+                    a[layout.a[at + v]] = sign * grad[v];
+                }
+                a[layout.a[at + width]] = -1.0 / SLACK_SCALE;
+                at += width + 1;
+                let row = layout.first_row + 2 * m + usize::from(sign < 0.0);
+                qp.b_mut()[row] = -sign * self.value[m];
+            }
+            set_box(
+                qp,
+                layout.first_slack + m,
+                0.0,
+                self.max_slack * SLACK_SCALE,
+            );
+            qp.q_mut()[layout.first_slack + m] = self.penalty / SLACK_SCALE;
+        }
+    }
+
+    /// Adds the penalty's decrease from the linear model itself, `W (|r| -
+    /// |r + g^T du|)` per row, not from the slacks: their solver tolerance (about
+    /// 1e-6 each, times `W`) would swamp small steps and keep the trust ratio
+    /// near 0.6.
+    fn add_predicted_decrease(&self, du: &[f64], acc: &mut f64) {
+        for m in 0..self.sample.len() {
+            let grad = &self.grad[m * self.n_u..(m + 1) * self.n_u];
+            let lin: f64 = self.value[m]
+                + grad
+                    .iter()
+                    .zip(&du[..self.n_u])
+                    .map(|(a, b)| a * b)
+                    .sum::<f64>();
+            *acc += self.penalty * (self.value[m].abs() - lin.abs());
+        }
+    }
+}
+
+/// A block's size and entries in one layout.
+struct Entries {
+    rows: usize,
+    slacks: usize,
+    slots: usize,
+    entries: Vec<(usize, usize)>,
+}
+
+/// A block of a [`RowSet`], by reference.
+#[derive(Debug)]
+pub enum Block<'a> {
+    /// One-sided rows.
+    Slots(&'a SlotRows),
+    /// Two-sided rows.
+    Pairs(&'a PairRows),
+}
+
+/// A block of a [`RowSet`], mutable.
+#[derive(Debug)]
+pub enum BlockMut<'a> {
+    /// One-sided rows.
+    Slots(&'a mut SlotRows),
+    /// Two-sided rows.
+    Pairs(&'a mut PairRows),
+}
+
+/// A subproblem's soft rows: its blocks in QP order (rows and slacks follow the
+/// box rows and the rate rows in this order).
+pub trait RowSet: std::fmt::Debug {
+    /// The blocks, in QP order.
+    fn blocks(&self) -> impl Iterator<Item = Block<'_>>;
+    /// The blocks, in QP order, mutable.
+    fn blocks_mut(&mut self) -> impl Iterator<Item = BlockMut<'_>>;
+
+    /// Forgets the last linearisation of every one-sided block (two-sided rows
+    /// are recorded in full each time).
+    fn clear(&mut self) {
+        for b in self.blocks_mut() {
+            if let BlockMut::Slots(s) = b {
+                s.clear();
+            }
+        }
+    }
+
+    /// The largest number of slots per sample of any one-sided block.
+    fn max_slots(&self) -> usize {
+        self.blocks()
+            .map(|b| match b {
+                Block::Slots(s) => s.slots(),
+                Block::Pairs(_) => 0,
+            })
+            .max()
+            .unwrap_or(0)
+    }
+}
+
+/// The blocks of a [`RowSet`] placed in one QP.
+pub(crate) struct Placement {
+    /// Every block's `(row, column)` entries (rows counted after the box rows).
+    pub entries: Vec<(usize, usize)>,
+    /// Per block: first row, first slack, slots per sample, entry count.
+    pub sizes: Vec<[usize; 4]>,
+    /// Extra rows in all (after the box rows).
+    pub rows: usize,
+    /// Variables in all.
+    pub variables: usize,
+}
+
+/// The layout of every block of `rows` in a QP with `slots` slots per sample,
+/// its rows from extra row `first_row` and its slacks from variable
+/// `first_slack` on.
+pub(crate) fn layout_entries(
+    rows: &impl RowSet,
+    slots: usize,
+    mut first_row: usize,
+    mut first_slack: usize,
+) -> Placement {
+    let mut entries = Vec::new();
+    let mut sizes = Vec::new();
+    for block in rows.blocks() {
+        let e = match block {
+            Block::Slots(s) => s.entries(slots, first_row, first_slack),
+            Block::Pairs(p) => p.entries(first_row, first_slack),
+        };
+        sizes.push([first_row, first_slack, e.slots, e.entries.len()]);
+        first_row += e.rows;
+        first_slack += e.slacks;
+        entries.extend(e.entries);
+    }
+    Placement {
+        entries,
+        sizes,
+        rows: first_row,
+        variables: first_slack,
+    }
+}
+
+/// The [`BlockLayout`]s of [`layout_entries`]' blocks, from the `A` slots of
+/// their entries (`a_slots`, in entry order) and the QP row of extra row 0.
+pub(crate) fn block_layouts(
+    rows: &impl RowSet,
+    sizes: &[[usize; 4]],
+    a_slots: &[usize],
+    extra_row0: usize,
+) -> Vec<BlockLayout> {
+    let mut at = 0;
+    rows.blocks()
+        .zip(sizes)
+        .map(|(block, &[first_row, first_slack, slots, len])| {
+            let a = a_slots[at..at + len].to_vec();
+            at += len;
+            let mut offsets = vec![0];
+            match block {
+                Block::Slots(s) => {
+                    for k in 0..slots * s.horizon {
+                        offsets.push(offsets[k] + s.width(slots, k) + 1);
+                    }
+                }
+                Block::Pairs(_) => offsets.push(len),
+            }
+            BlockLayout {
+                slots,
+                first_row: extra_row0 + first_row,
+                first_slack,
+                a,
+                offsets,
+            }
+        })
+        .collect()
+}
+
+/// Drops the one-sided rows the boxes imply; returns the slots per sample the
+/// step needs (the layout to use).
+pub(crate) fn prune(rows: &mut impl RowSet, lo: &[f64], hi: &[f64]) -> usize {
+    let mut used = 0;
+    for b in rows.blocks_mut() {
+        if let BlockMut::Slots(s) = b {
+            s.drop_redundant(lo, hi);
+            used = used.max(s.slots_used());
+        }
+    }
+    used
+}
+
+/// Writes every block's rows into `qp` (the layouts of that QP).
+pub(crate) fn load(rows: &impl RowSet, layouts: &[BlockLayout], qp: &mut Qp) {
+    for (block, layout) in rows.blocks().zip(layouts) {
+        match block {
+            Block::Slots(s) => s.load(layout, qp),
+            Block::Pairs(p) => p.load(layout, qp),
+        }
+    }
+}
+
+/// The blocks' predicted decrease of their penalties for the QP solution `x`,
+/// added to `acc`: the one-sided blocks first (each as one sum), then the
+/// two-sided ones (row by row).
+pub(crate) fn add_predicted_decrease(
+    rows: &impl RowSet,
+    layouts: &[BlockLayout],
+    x: &[f64],
+    n_u: usize,
+    acc: &mut f64,
+) {
+    for (block, layout) in rows.blocks().zip(layouts) {
+        if let Block::Slots(s) = block {
+            *acc += s.predicted_decrease(layout, x);
+        }
+    }
+    for block in rows.blocks() {
+        if let Block::Pairs(p) = block {
+            p.add_predicted_decrease(&x[..n_u], acc);
+        }
+    }
+}
