@@ -194,6 +194,12 @@ pub struct ControllerConfig {
     pub inner: InnerLoopParams,
     /// How the MPC tracks the reference system's output.
     pub tracking: TrackingParams,
+    /// Wall-clock budget of one control sample (s; 0: none). When set, the
+    /// optimisation stops iterating once the budget is spent (after at least one
+    /// ADMM iteration or SCP step) and applies the best iterate so far, which
+    /// satisfies every bound; the report says so (`budget_hit`). A budget makes
+    /// the run depend on the machine's speed; 0 keeps it deterministic.
+    pub sample_time_budget: f64,
 }
 
 impl ControllerConfig {
@@ -221,6 +227,7 @@ impl ControllerConfig {
             guidance,
             inner: InnerLoopParams::default(),
             tracking: TrackingParams::default(),
+            sample_time_budget: 0.0,
         }
     }
 
@@ -265,6 +272,7 @@ impl ControllerConfig {
             ("los_distance", self.tracking.los_distance),
             ("port_turn_margin", self.tracking.port_turn_margin),
             ("port_turn_weight", self.ship.port_turn_weight),
+            ("sample_time_budget", self.sample_time_budget),
             (
                 "centralized_thrust_rate_weight",
                 self.centralized.thrust_rate_weight,

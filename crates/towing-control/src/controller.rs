@@ -22,7 +22,7 @@
 //! Algorithm 1 then applies its last iterate, which satisfies every bound; the
 //! report says `converged = false` and the FMU reports it as a diagnostic.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use towing_guidance::{
     body_to_ned, role, GuidanceOutput, GuidanceParams, ObstacleInput, Pose, ReferenceSystem, Role,
@@ -141,8 +141,13 @@ pub struct SampleReport {
     pub role: [i32; MAX_OBSTACLES],
     /// ADMM iterations (1 for the centralized problem's single SCP loop count).
     pub iterations: usize,
-    /// Whether eq. (29) stopped the ADMM.
+    /// Whether eq. (29) stopped the ADMM (the centralized problem: its
+    /// first-move rule).
     pub converged: bool,
+    /// Whether the sample's time budget ([`ControllerConfig::sample_time_budget`])
+    /// ended the optimisation: the best iterate within every bound so far was
+    /// applied.
+    pub budget_hit: bool,
     /// Last primal residual per tug.
     pub r_pri: [f64; 2],
     /// Last dual residual per tug.
@@ -360,7 +365,12 @@ impl Controller {
             obstacles: &self.mpc_obstacles[..n_obstacles],
             heading_floor,
         };
-        let report = self.solver.solve(&input, Budget::unlimited());
+        let budget = Budget::from(
+            start,
+            (self.config.sample_time_budget > 0.0)
+                .then(|| Duration::from_secs_f64(self.config.sample_time_budget)),
+        );
+        let report = self.solver.solve(&input, budget);
         let ship_plan = self.solver.ship_plan();
         let tug_plans = [self.solver.tug_plan(0), self.solver.tug_plan(1)];
         let finite = ship_plan.iter().flatten().all(|v| v.is_finite())
@@ -419,6 +429,7 @@ impl Controller {
             role: roles,
             iterations: report.iterations,
             converged: report.converged,
+            budget_hit: report.budget_hit,
             r_pri: report.r_pri,
             r_dual: report.r_dual,
             compute_time: start.elapsed().as_secs_f64(),
@@ -647,7 +658,7 @@ impl Controller {
         if from_plan {
             out.ship = *self.solver.ship_predicted();
             for i in 0..2 {
-                out.tugs[i] = *self.solver.tug_predicted(i);
+                out.tugs[i] = self.solver.tug_predicted(i);
             }
         } else {
             let model: &ShipModel = self.solver.ship_model();

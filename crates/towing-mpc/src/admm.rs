@@ -53,7 +53,12 @@ use crate::ship::{ShipInput, ShipModel, ShipState};
 use crate::ship_mpc::{ShipMpc, ShipMpcParams, ShipStepData};
 use crate::tug::{TowlinePull, TugInput, TugModel, TugState};
 use crate::tug_mpc::{TugMpc, TugMpcParams, TugStepData};
+
+mod helper;
+
 use crate::HORIZON;
+pub use helper::TugRef;
+use helper::{poses, Poses, Tug2};
 
 /// Capacity of the residual history, and the largest `max_iterations` accepted.
 pub const MAX_ITERATIONS: usize = 100;
@@ -72,6 +77,11 @@ pub struct AdmmSettings {
     pub eps_abs: f64,
     /// `eps_rel` of eq. (29) (>= 0).
     pub eps_rel: f64,
+    /// Run the two tugs' steps of an iteration in parallel (tug 2 on a helper
+    /// thread), as the paper's distributed architecture has each tug solve its
+    /// own problem. The results are bit-identical either way (each tug's
+    /// arithmetic is its own); only the wall time differs.
+    pub parallel_tugs: bool,
 }
 
 impl Default for AdmmSettings {
@@ -85,6 +95,7 @@ impl Default for AdmmSettings {
             max_iterations: 30,
             eps_abs: 1e-3,
             eps_rel: 1e-3,
+            parallel_tugs: true,
         }
     }
 }
@@ -260,7 +271,9 @@ impl AdmmReport {
 pub struct Admm {
     settings: AdmmSettings,
     ship: ShipMpc,
-    tugs: [TugMpc; 2],
+    tug1: TugMpc,
+    /// Tug 2's problem, on a helper thread with [`AdmmSettings::parallel_tugs`].
+    tug2: Tug2,
     formation: FormationMap,
     lambda: [[[f64; 3]; HORIZON]; 2],
     f_prev: [[[f64; 3]; HORIZON]; 2],
@@ -285,10 +298,12 @@ impl Admm {
             }
         }
         let formation = *ship.problem().formation();
+        let [tug1, tug2] = tugs;
         Ok(Admm {
             settings,
             ship,
-            tugs,
+            tug1,
+            tug2: Tug2::new(tug2, settings.parallel_tugs),
             formation,
             lambda: [[[0.0; 3]; HORIZON]; 2],
             f_prev: [[[0.0; 3]; HORIZON]; 2],
@@ -349,13 +364,18 @@ impl Admm {
         &self.ship
     }
 
-    /// Tug `i`'s local problem.
+    /// Tug `i`'s local problem (tug 2's behind the helper thread's lock while
+    /// the borrow lasts).
     ///
     /// # Panics
     /// If `i > 1`.
     #[must_use]
-    pub fn tug(&self, i: usize) -> &TugMpc {
-        &self.tugs[i]
+    pub fn tug(&self, i: usize) -> TugRef<'_> {
+        match i {
+            0 => TugRef::Here(&self.tug1),
+            1 => self.tug2.get(),
+            _ => panic!("tug index {i} out of range (0 = tug 1, 1 = tug 2)"),
+        }
     }
 
     /// The multipliers `lambda_i` (per sample, `[x, y, psi]`).
@@ -369,9 +389,8 @@ impl Admm {
         self.lambda = [[[0.0; 3]; HORIZON]; 2];
         self.warm = false;
         self.ship.trust_region_mut().reset();
-        for tug in &mut self.tugs {
-            tug.trust_region_mut().reset();
-        }
+        self.tug1.trust_region_mut().reset();
+        self.tug2.get_mut().trust_region_mut().reset();
     }
 
     /// Warm start for the next sample: plans and multipliers one sample ahead,
@@ -381,9 +400,8 @@ impl Admm {
             std::array::from_fn(|h| a[(h + 1).min(HORIZON - 1)])
         }
         self.ship.shift();
-        for tug in &mut self.tugs {
-            tug.shift();
-        }
+        self.tug1.shift();
+        self.tug2.get_mut().shift();
         for i in 0..2 {
             self.lambda[i] = shifted(&self.lambda[i]);
             self.f_prev[i] = shifted(&self.f_prev[i]);
@@ -400,113 +418,90 @@ impl Admm {
     /// [`Admm::solve_sample`] stopping once `budget` is spent (after at least one
     /// iteration): the last iterate is applied, as at `max_iterations`.
     pub fn solve_within(&mut self, input: &SampleInput<'_>, budget: Budget) -> AdmmReport {
-        let s = self.settings;
         if !self.warm {
             self.ship.set_inputs([input.previous.ship; HORIZON]);
-            for (tug, tau) in self.tugs.iter_mut().zip(input.previous.tugs) {
-                tug.set_inputs([tau; HORIZON]);
-            }
+            self.tug1.set_inputs([input.previous.tugs[0]; HORIZON]);
+            self.tug2
+                .get_mut()
+                .set_inputs([input.previous.tugs[1]; HORIZON]);
             self.lambda = [[[0.0; 3]; HORIZON]; 2];
         }
+        Core {
+            settings: self.settings,
+            ship: &mut self.ship,
+            tug1: &mut self.tug1,
+            tug2: &mut self.tug2,
+            formation: &self.formation,
+            lambda: &mut self.lambda,
+            f_prev: &mut self.f_prev,
+        }
+        .run(input, budget)
+    }
+}
+
+/// One sample's loop over the borrowed parts of an [`Admm`].
+struct Core<'a> {
+    settings: AdmmSettings,
+    ship: &'a mut ShipMpc,
+    tug1: &'a mut TugMpc,
+    tug2: &'a mut Tug2,
+    formation: &'a FormationMap,
+    lambda: &'a mut [[[f64; 3]; HORIZON]; 2],
+    f_prev: &'a mut [[[f64; 3]; HORIZON]; 2],
+}
+
+/// The ship's plan and predicted states, and the tug references along them.
+struct ShipSide {
+    plan: [ShipInput; HORIZON],
+    states: [ShipState; HORIZON],
+    f: [[[f64; 3]; HORIZON]; 2],
+}
+
+impl Core<'_> {
+    /// Algorithm 1 for one sample (module docs).
+    fn run(&mut self, input: &SampleInput<'_>, budget: Budget) -> AdmmReport {
         // Tug headings unwrapped next to the ship's.
         let mut tug_states = input.tugs;
         for x in &mut tug_states {
             x[2] = input.ship[2] + angle_difference(x[2], input.ship[2]);
         }
         // f^0: the references along the current ship plan.
-        let mut ship_plan = self.ship.inputs();
-        let mut ship_states = self
+        let plan = self.ship.inputs();
+        let states = self
             .ship
             .problem()
             .model()
-            .rollout::<HORIZON>(&input.ship, &ship_plan);
-        let mut f = [[[0.0; 3]; HORIZON]; 2];
-        for i in 0..2 {
-            self.formation
-                .tug_references_into(i, &ship_states, &ship_plan, &mut f[i]);
-        }
-        self.f_prev = f;
-
+            .rollout::<HORIZON>(&input.ship, &plan);
+        let mut side = self.ship_side(plan, states);
+        *self.f_prev = side.f;
         let mut history = [IterationRecord::default(); MAX_ITERATIONS];
-        let mut last_steps = [None; 3];
-        let mut failed_steps = 0;
-        let mut iterations = 0;
-        let mut converged = false;
-        let mut budget_hit = false;
-        while iterations < s.max_iterations {
+        let mut last_steps = [ScpReport::never_run(); 3];
+        let (mut failed_steps, mut iterations) = (0, 0);
+        let (mut converged, mut budget_hit) = (false, false);
+        while iterations < self.settings.max_iterations {
             if iterations > 0 && budget.spent() {
                 budget_hit = true;
                 break;
             }
             // (1) tug steps given f^{s-1}, the pulls of the ship plan, lambda^{s-1}.
-            let mut g = [[[0.0; 3]; HORIZON]; 2];
-            for i in 0..2 {
-                let pulls = std::array::from_fn(|h| {
-                    let psi = if h == 0 {
-                        input.ship[2]
-                    } else {
-                        ship_states[h - 1][2]
-                    };
-                    TowlinePull::from_plan(ship_plan[h][i], psi, ship_plan[h][2 + i])
-                });
-                let data = TugStepData {
-                    state: tug_states[i],
-                    pulls,
-                    reference: f[i],
-                    lambda: self.lambda[i],
-                    rho: s.rho,
-                    obstacles: input.obstacles,
-                };
-                let report = self.tugs[i].step(&data);
-                failed_steps += usize::from(!report.qp.is_usable());
-                last_steps[i] = Some(report);
-                for (gh, x) in g[i].iter_mut().zip(self.tugs[i].predicted()) {
-                    *gh = [x[0], x[1], x[2]];
-                }
-            }
+            let (steps, g) = self.tug_steps(input, &tug_states, &side);
             // (2) ship step given g^s and lambda^{s-1}.
-            let data = ShipStepData {
+            let ship = self.ship.step(&ShipStepData {
                 state: input.ship,
                 previous: input.previous.ship,
                 reference: input.reference,
                 tug_poses: g,
-                lambda: self.lambda,
-                rho: s.rho,
+                lambda: *self.lambda,
+                rho: self.settings.rho,
                 obstacles: input.obstacles,
                 heading_floor: input.heading_floor,
-            };
-            let report = self.ship.step(&data);
-            failed_steps += usize::from(!report.qp.is_usable());
-            last_steps[2] = Some(report);
-            ship_states = *self.ship.predicted();
-            ship_plan = self.ship.inputs();
-            for i in 0..2 {
-                self.formation
-                    .tug_references_into(i, &ship_states, &ship_plan, &mut f[i]);
-            }
+            });
+            last_steps = [steps[0], steps[1], ship];
+            failed_steps += last_steps.iter().filter(|r| !r.qp.is_usable()).count();
+            side = self.ship_side(self.ship.inputs(), *self.ship.predicted());
             // (3) multipliers, (4) residuals and tolerances.
-            let mut record = IterationRecord::default();
-            for i in 0..2 {
-                let (mut pri, mut dual, mut gn, mut fn_, mut ln) = (0.0, 0.0, 0.0, 0.0, 0.0);
-                for h in 0..HORIZON {
-                    let r = difference(&g[i][h], &f[i][h]);
-                    let d = difference(&f[i][h], &self.f_prev[i][h]);
-                    for c in 0..3 {
-                        self.lambda[i][h][c] += s.rho * r[c];
-                        pri += r[c] * r[c];
-                        dual += d[c] * d[c];
-                        gn += g[i][h][c] * g[i][h][c];
-                        fn_ += f[i][h][c] * f[i][h][c];
-                        ln += self.lambda[i][h][c] * self.lambda[i][h][c];
-                    }
-                }
-                let base = (N_S as f64).sqrt() * s.eps_abs;
-                record.r_pri[i] = pri.sqrt();
-                record.r_dual[i] = dual.sqrt();
-                record.eps_pri[i] = base + s.eps_rel * gn.sqrt().max(fn_.sqrt());
-                record.eps_dual[i] = base + s.eps_rel * ln.sqrt();
-            }
-            self.f_prev = f;
+            let record = self.update_multipliers(&g, &side.f);
+            *self.f_prev = side.f;
             history[iterations] = record;
             iterations += 1;
             if record.satisfied() {
@@ -515,7 +510,7 @@ impl Admm {
             }
         }
         let last = history[iterations - 1];
-        let first = ship_plan[0];
+        let first = side.plan[0];
         AdmmReport {
             iterations,
             converged,
@@ -525,12 +520,79 @@ impl Admm {
             eps_pri: last.eps_pri,
             eps_dual: last.eps_dual,
             history,
-            last_steps: last_steps.map(|r| r.unwrap_or_else(ScpReport::never_run)),
+            last_steps,
             failed_steps,
             tension: [first[0], first[1]],
             angle: [first[2], first[3]],
-            tug_thrust: [self.tugs[0].inputs()[0], self.tugs[1].inputs()[0]],
+            tug_thrust: [self.tug1.inputs()[0], self.tug2.get().inputs()[0]],
         }
+    }
+
+    /// The ship side of an iteration: its plan, states and the references `f_i`.
+    fn ship_side(&self, plan: [ShipInput; HORIZON], states: [ShipState; HORIZON]) -> ShipSide {
+        let mut f = [[[0.0; 3]; HORIZON]; 2];
+        for (i, fi) in f.iter_mut().enumerate() {
+            self.formation.tug_references_into(i, &states, &plan, fi);
+        }
+        ShipSide { plan, states, f }
+    }
+
+    /// Both tugs' steps of one iteration (tug 2's possibly in parallel): their
+    /// reports and predicted poses `g_i`.
+    fn tug_steps(
+        &mut self,
+        input: &SampleInput<'_>,
+        tug_states: &[TugState; 2],
+        side: &ShipSide,
+    ) -> ([ScpReport; 2], [Poses; 2]) {
+        let data = |i: usize| TugStepData {
+            state: tug_states[i],
+            pulls: std::array::from_fn(|h| {
+                let psi = if h == 0 {
+                    input.ship[2]
+                } else {
+                    side.states[h - 1][2]
+                };
+                TowlinePull::from_plan(side.plan[h][i], psi, side.plan[h][2 + i])
+            }),
+            reference: side.f[i],
+            lambda: self.lambda[i],
+            rho: self.settings.rho,
+            obstacles: input.obstacles,
+        };
+        self.tug2.start(&data(1));
+        let first = self.tug1.step(&data(0));
+        let g1 = poses(self.tug1);
+        let (second, g2) = self.tug2.finish();
+        ([first, second], [g1, g2])
+    }
+
+    /// `lambda_i += rho (g_i - f_i)` (27) and the residuals and tolerances of
+    /// (28)-(29).
+    fn update_multipliers(&mut self, g: &[Poses; 2], f: &[Poses; 2]) -> IterationRecord {
+        let s = self.settings;
+        let mut record = IterationRecord::default();
+        for i in 0..2 {
+            let (mut pri, mut dual, mut gn, mut fn_, mut ln) = (0.0, 0.0, 0.0, 0.0, 0.0);
+            for h in 0..HORIZON {
+                let r = difference(&g[i][h], &f[i][h]);
+                let d = difference(&f[i][h], &self.f_prev[i][h]);
+                for c in 0..3 {
+                    self.lambda[i][h][c] += s.rho * r[c];
+                    pri += r[c] * r[c];
+                    dual += d[c] * d[c];
+                    gn += g[i][h][c] * g[i][h][c];
+                    fn_ += f[i][h][c] * f[i][h][c];
+                    ln += self.lambda[i][h][c] * self.lambda[i][h][c];
+                }
+            }
+            let base = (N_S as f64).sqrt() * s.eps_abs;
+            record.r_pri[i] = pri.sqrt();
+            record.r_dual[i] = dual.sqrt();
+            record.eps_pri[i] = base + s.eps_rel * gn.sqrt().max(fn_.sqrt());
+            record.eps_dual[i] = base + s.eps_rel * ln.sqrt();
+        }
+        record
     }
 }
 

@@ -42,7 +42,7 @@ pub trait Optimizer: std::fmt::Debug {
     /// The ship's predicted states of the plan.
     fn ship_predicted(&self) -> &[ShipState; HORIZON];
     /// Tug `i`'s predicted states of the plan.
-    fn tug_predicted(&self, i: usize) -> &[TugState; HORIZON];
+    fn tug_predicted(&self, i: usize) -> [TugState; HORIZON];
     /// The ship's prediction model.
     fn ship_model(&self) -> &ShipModel;
     /// The next sample starts cold.
@@ -80,8 +80,8 @@ impl Optimizer for Admm {
         self.ship().predicted()
     }
 
-    fn tug_predicted(&self, i: usize) -> &[TugState; HORIZON] {
-        self.tug(i).predicted()
+    fn tug_predicted(&self, i: usize) -> [TugState; HORIZON] {
+        *self.tug(i).predicted()
     }
 
     fn ship_model(&self) -> &ShipModel {
@@ -123,8 +123,8 @@ impl Optimizer for Centralized {
         Centralized::ship_predicted(self)
     }
 
-    fn tug_predicted(&self, i: usize) -> &[TugState; HORIZON] {
-        Centralized::tug_predicted(self, i)
+    fn tug_predicted(&self, i: usize) -> [TugState; HORIZON] {
+        *Centralized::tug_predicted(self, i)
     }
 
     fn ship_model(&self) -> &ShipModel {

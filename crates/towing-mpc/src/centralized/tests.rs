@@ -75,6 +75,7 @@ fn tight_admm(rho: f64) -> Admm {
             max_iterations: MAX_ITERATIONS,
             eps_abs: 1e-6,
             eps_rel: 1e-6,
+            ..AdmmSettings::default()
         },
     )
     .unwrap()
