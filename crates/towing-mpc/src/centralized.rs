@@ -95,6 +95,11 @@ const NC: usize = 2 * HORIZON * 3;
 /// `d x / d u` of a predicted state w.r.t. all increments.
 type Sens = SMatrix<f64, 6, NU>;
 
+/// The vessels' bits in [`crate::engine::Channel::moves`]: the ship's inputs move
+/// all three (the tugs through the pulls), a tug's thrust its own tug only.
+const SHIP: u8 = 1;
+const TUG: [u8; 2] = [2, 4];
+
 /// Index of ship channel `k` of sample `h`.
 fn ship_var(h: usize, k: usize) -> usize {
     PER_STEP * h + k
@@ -118,10 +123,12 @@ pub struct CentralizedSettings {
     /// Converged when an accepted step changes every first-move channel by less
     /// than this (N, rad, N m).
     pub tolerance: f64,
+    /// Converged when an accepted step lowers the merit by less than this
+    /// fraction of it (`max(1, |J|)`): the SCP converges linearly near a
+    /// solution, so what is left is a few such steps' worth.
+    pub cost_tolerance: f64,
     /// `W_c`: L1 penalty of the configuration restriction (per m, per rad).
     pub consensus_penalty: f64,
-    /// Largest consensus slack (m, rad); keeps the QP bounded.
-    pub max_consensus_slack: f64,
     /// Trust region (scales: the subproblems' `trust_scale`).
     pub scp: ScpSettings,
     /// `w_dtau`: weight of the tugs' thrust changes
@@ -135,9 +142,9 @@ impl Default for CentralizedSettings {
     fn default() -> Self {
         CentralizedSettings {
             max_iterations: 60,
-            tolerance: 1e-4,
+            tolerance: 1e-3,
+            cost_tolerance: 1e-5,
             consensus_penalty: 1e3,
-            max_consensus_slack: 10.0,
             scp: ScpSettings::default(),
             thrust_rate_weight: 0.01,
         }
@@ -159,19 +166,19 @@ impl CentralizedSettings {
         if self.max_iterations == 0 {
             return bad("max_iterations", "must be >= 1".into());
         }
-        for (field, v) in [
-            ("consensus_penalty", self.consensus_penalty),
-            ("max_consensus_slack", self.max_consensus_slack),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return bad(field, format!("must be finite and > 0, got {v}"));
-            }
-        }
-        if !(self.tolerance.is_finite() && self.tolerance >= 0.0) {
+        if !(self.consensus_penalty.is_finite() && self.consensus_penalty > 0.0) {
             return bad(
-                "tolerance",
-                format!("must be finite and >= 0, got {}", self.tolerance),
+                "consensus_penalty",
+                format!("must be finite and > 0, got {}", self.consensus_penalty),
             );
+        }
+        for (field, v) in [
+            ("tolerance", self.tolerance),
+            ("cost_tolerance", self.cost_tolerance),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(field, format!("must be finite and >= 0, got {v}"));
+            }
         }
         if !(self.thrust_rate_weight.is_finite() && self.thrust_rate_weight >= 0.0) {
             return bad(
@@ -578,19 +585,16 @@ impl Subproblem for CentralProblem {
     }
 
     fn rows(&self) -> CentralRows {
-        let samples = (0..NC).map(|m| (m / 3) % HORIZON).collect();
+        // Row m = cons_index(i, h, c): sample h, about tug i and the ship.
+        let rows = (0..NC)
+            .map(|m| ((m / 3) % HORIZON, SHIP | TUG[m / (3 * HORIZON)]))
+            .collect();
         CentralRows {
-            consensus: PairRows::new(
-                samples,
-                PER_STEP,
-                HORIZON,
-                self.settings.consensus_penalty,
-                self.settings.max_consensus_slack,
-            ),
+            consensus: PairRows::new(rows, NU, self.settings.consensus_penalty),
             clearance: [
-                self.ship_params.clearance.rows(PER_STEP),
-                self.tug_params.clearance.rows(PER_STEP),
-                self.tug_params.clearance.rows(PER_STEP),
+                self.ship_params.clearance.rows(PER_STEP, SHIP),
+                self.tug_params.clearance.rows(PER_STEP, TUG[0]),
+                self.tug_params.clearance.rows(PER_STEP, TUG[1]),
             ],
         }
     }
@@ -682,8 +686,9 @@ impl Centralized {
         }
         settings.validate()?;
         let mut channels = ship_params.channels().to_vec();
-        channels.extend(tug_params.channels());
-        channels.extend(tug_params.channels());
+        for tug in TUG {
+            channels.extend(tug_params.channels().map(|c| c.moving(tug)));
+        }
         let problem = CentralProblem {
             ship,
             tugs,
@@ -851,7 +856,11 @@ impl Centralized {
             let stationary = usable
                 && ((!report.accepted && report.ratio == 1.0)
                     || report.predicted_decrease <= 1e-6 * report.cost_before.abs().max(1.0));
-            if (report.accepted && report.first_move_change < settings.tolerance) || stationary {
+            let settled = report.accepted
+                && (report.first_move_change < settings.tolerance
+                    || report.cost_before - report.cost_after
+                        < settings.cost_tolerance * report.cost_before.abs().max(1.0));
+            if settled || stationary {
                 converged = true;
                 break;
             }

@@ -52,7 +52,7 @@ pub struct ClearanceParams {
     pub min_distance: f64,
     /// `W`: L1 penalty on the slack (per m).
     pub penalty: f64,
-    /// Upper bound of a slack (m); keeps the QP bounded.
+    /// Upper bound of a slack (m).
     pub max_slack: f64,
 }
 
@@ -74,13 +74,14 @@ impl ClearanceParams {
         self.penalty * (self.min_distance - d).max(0.0)
     }
 
-    /// The block of rows over `per_step` increments per sample.
+    /// The block of rows over `per_step` increments per sample, about the
+    /// states of `vessels` ([`crate::engine::Channel::moves`]).
     #[must_use]
-    pub fn rows(&self, per_step: usize) -> SlotRows {
+    pub fn rows(&self, per_step: usize, vessels: u8) -> SlotRows {
         SlotRows::new(
             self.max_obstacles,
-            HORIZON,
-            per_step,
+            (HORIZON, per_step),
+            vessels,
             self.penalty,
             self.max_slack,
         )

@@ -142,6 +142,9 @@ pub struct Qp {
     solver: DefaultSolver<f64>,
     /// Upper triangle of `P`, column-major (`(i, j)`, `i <= j`, at `j (j + 1) / 2 + i`).
     p: Vec<f64>,
+    /// For a sparse `P`: the packed index of each CSC entry, and the CSC values.
+    p_gather: Option<Vec<usize>>,
+    p_csc: Vec<f64>,
     q: Vec<f64>,
     a: Vec<f64>,
     b: Vec<f64>,
@@ -196,6 +199,19 @@ impl Qp {
     /// (no entries) over the rest: the packed upper triangle has
     /// `n_p (n_p + 1) / 2` entries, indexed by [`upper_index`] as before.
     pub fn with_p_block(a: Pattern, m_eq: usize, n_p: usize) -> Result<Qp, QpBuildError> {
+        Qp::with_p_pattern(a, m_eq, n_p, |_, _| true)
+    }
+
+    /// As [`Qp::with_p_block`] with entries `(i, j)` of `P` only where
+    /// `coupled(i, j)` (and on the diagonal): values written elsewhere in the
+    /// packed triangle ([`Qp::p_mut`]) must be zero, and are not passed to the
+    /// solver. A sparser `P` is a sparser KKT system to factor.
+    pub fn with_p_pattern(
+        a: Pattern,
+        m_eq: usize,
+        n_p: usize,
+        coupled: impl Fn(usize, usize) -> bool,
+    ) -> Result<Qp, QpBuildError> {
         let (n, m) = (a.n, a.m);
         if m_eq > m || n_p > n || a.colptr.len() != n + 1 || a.rowval.len() != a.colptr[n] {
             return Err(QpBuildError("inconsistent pattern".into()));
@@ -203,18 +219,23 @@ impl Qp {
         let np = n_p * (n_p + 1) / 2;
         let mut p_colptr = Vec::with_capacity(n + 1);
         let mut p_rowval = Vec::with_capacity(np);
-        let mut p_init = vec![0.0; np];
+        let mut p_init = Vec::with_capacity(np);
+        let mut gather = Vec::with_capacity(np);
         p_colptr.push(0);
         for j in 0..n {
             if j < n_p {
-                for i in 0..=j {
+                for i in (0..=j).filter(|&i| i == j || coupled(i, j)) {
                     p_rowval.push(i);
+                    p_init.push(if i == j { 1.0 } else { 0.0 });
+                    gather.push(upper_index(i, j));
                 }
-                p_init[upper_index(j, j)] = 1.0;
             }
             p_colptr.push(p_rowval.len());
         }
-        let p_mat = CscMatrix::new(n, n, p_colptr, p_rowval, p_init.clone());
+        // Dense: the packed triangle is the CSC value array itself.
+        let p_gather = (gather.len() < np).then_some(gather);
+        let p_csc = vec![0.0; p_init.len()];
+        let p_mat = CscMatrix::new(n, n, p_colptr, p_rowval, p_init);
         let nnz = a.rowval.len();
         let a_mat = CscMatrix::new(m, n, a.colptr, a.rowval, vec![1.0; nnz]);
         let q = vec![0.0; n];
@@ -232,6 +253,8 @@ impl Qp {
             n,
             m_eq,
             solver,
+            p_gather,
+            p_csc,
             p: vec![0.0; np],
             q,
             a: vec![0.0; nnz],
@@ -290,9 +313,18 @@ impl Qp {
         if !finite {
             return QpOutcome::Failed(QpFailure::BadData);
         }
+        let p = match &self.p_gather {
+            Some(gather) => {
+                for (v, &k) in self.p_csc.iter_mut().zip(gather) {
+                    *v = self.p[k];
+                }
+                &self.p_csc
+            }
+            None => &self.p,
+        };
         let pushed = self
             .solver
-            .update_P(&self.p)
+            .update_P(p)
             .and_then(|()| self.solver.update_q(&self.q))
             .and_then(|()| self.solver.update_A(&self.a))
             .and_then(|()| self.solver.update_b(&self.b));

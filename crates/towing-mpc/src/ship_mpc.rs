@@ -32,7 +32,8 @@ use nalgebra::Matrix6x4;
 
 use crate::costs::{angle_difference, obstacle_terms, ship_stage_terms, ClearanceParams};
 use crate::engine::{
-    Block, BlockMut, Channel, InputSpace, QuadModel, RowSet, Scp, ScpSettings, SlotRows, Subproblem,
+    Block, BlockMut, Channel, InputSpace, QuadModel, RowSet, Scp, ScpSettings, SlotRows,
+    Subproblem, ALL_VESSELS,
 };
 use crate::formation::FormationMap;
 use crate::obstacle::{DistanceCost, Obstacle};
@@ -153,6 +154,7 @@ impl ShipMpcParams {
                 upper,
                 rate,
                 trust_scale: self.trust_scale[k / 2],
+                moves: ALL_VESSELS,
             }
         })
     }
@@ -272,7 +274,7 @@ impl Subproblem for ShipProblem {
 
     fn rows(&self) -> ShipRows {
         ShipRows {
-            clearance: self.params.clearance.rows(4),
+            clearance: self.params.clearance.rows(4, ALL_VESSELS),
         }
     }
 

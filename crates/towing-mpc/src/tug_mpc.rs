@@ -29,7 +29,8 @@ use nalgebra::Matrix6x3;
 
 use crate::costs::{angle_difference, obstacle_terms, ClearanceParams};
 use crate::engine::{
-    Block, BlockMut, Channel, InputSpace, QuadModel, RowSet, Scp, ScpSettings, SlotRows, Subproblem,
+    Block, BlockMut, Channel, InputSpace, QuadModel, RowSet, Scp, ScpSettings, SlotRows,
+    Subproblem, ALL_VESSELS,
 };
 use crate::obstacle::{DistanceCost, Obstacle};
 use crate::qp::QpBuildError;
@@ -177,7 +178,7 @@ impl Subproblem for TugProblem {
 
     fn rows(&self) -> TugRows {
         TugRows {
-            clearance: self.params.clearance.rows(3),
+            clearance: self.params.clearance.rows(3, ALL_VESSELS),
         }
     }
 

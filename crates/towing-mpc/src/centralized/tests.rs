@@ -85,6 +85,7 @@ fn tight_settings() -> CentralizedSettings {
     CentralizedSettings {
         max_iterations: 200,
         tolerance: 1e-7,
+        cost_tolerance: 0.0,
         // The same problem as the ADMM's (no move suppression, see
         // `thrust_rate_terms`).
         thrust_rate_weight: 0.0,

@@ -2,8 +2,8 @@
 //! use, built at construction and updated in place.
 //!
 //! Variables: the increments, then each block's slacks in block order. Rows: two
-//! box rows per variable (`2 j`: `x_j <= hi_j`, `2 j + 1`: `-x_j <= -lo_j`), then
-//! the rate rows, then each block's rows. `P` is dense over the increments and
+//! box rows per increment (`2 j`: `x_j <= hi_j`, `2 j + 1`: `-x_j <= -lo_j`) and
+//! per boxed slack, then the rate rows, then each block's rows. `P` is dense over the increments and
 //! zero over the slacks. A step uses the smallest layout that holds the slots
 //! recorded (an unused slot is a row `-s <= 0` on a slack of positive cost: its
 //! slack is zero at the optimum, so a layout without it has the same solution in
@@ -30,15 +30,20 @@ impl Layout {
         let rate = space.rate_entries(0);
         let n_rate = rate.len();
         let mut entries: Vec<(usize, usize)> = rate.iter().map(|(e, _)| *e).collect();
-        let placed = rows::layout_entries(rows, slots, space.rate_rows(), n_u);
+        let moves = space.moves();
+        let reach = rows::Reach {
+            moves: &moves,
+            per_step: space.per_step(),
+        };
+        let placed = rows::layout_entries(rows, slots, reach, space.rate_rows(), n_u);
         let n = placed.variables;
-        entries.extend(placed.entries);
-        let (mut qp, a_slots) = box_qp(n, n_u, placed.rows, &entries)?;
+        entries.extend(&placed.entries);
+        let (mut qp, a_slots) = box_qp(space, n, &placed.boxed, placed.rows, &entries)?;
         for (slot, (_, v)) in a_slots[..n_rate].iter().zip(&rate) {
             qp.a_mut()[*slot] = *v;
         }
-        let rate_row = 2 * n;
-        let blocks = rows::block_layouts(rows, &placed.sizes, &a_slots[n_rate..], rate_row);
+        let rate_row = 2 * placed.boxed.len();
+        let blocks = placed.block_layouts(&a_slots[n_rate..], rate_row);
         Ok(Layout {
             qp,
             rate_row,
@@ -121,24 +126,30 @@ impl Layouts {
     }
 }
 
-/// A QP in `n` variables with a box per variable (rows `2 j`: `x_j <= hi_j`,
-/// `2 j + 1`: `-x_j <= -lo_j`) followed by `extra_rows` rows of the given
-/// entries (row indices counted from 0 after the box). Returns the QP and, per
-/// extra entry, its slot in the value array of `A`. `P` is dense over the first
-/// `n_p` variables and zero over the rest.
+/// A QP in `n` variables with a box on each variable of `boxed` (box `k`, of
+/// variable `boxed[k]`: rows `2 k`: `x <= hi`, `2 k + 1`: `-x <= -lo`) followed
+/// by `extra_rows` rows of the given entries (row indices counted from 0 after
+/// the boxes). Returns the QP and, per extra entry, its slot in the value array
+/// of `A`. `P` has the entries of the coupled increments
+/// ([`InputSpace::coupled`]) and none over the slacks.
 fn box_qp(
+    space: &InputSpace,
     n: usize,
-    n_p: usize,
+    boxed: &[usize],
     extra_rows: usize,
     extra: &[(usize, usize)],
 ) -> Result<(Qp, Vec<usize>), QpBuildError> {
-    let mut entries: Vec<(usize, usize)> =
-        (0..n).flat_map(|j| [(2 * j, j), (2 * j + 1, j)]).collect();
-    entries.extend(extra.iter().map(|&(r, c)| (2 * n + r, c)));
-    let (pattern, slots) = Pattern::from_entries(2 * n + extra_rows, n, &entries)?;
-    let mut qp = Qp::with_p_block(pattern, 0, n_p)?;
-    for (k, slot) in slots[..2 * n].iter().enumerate() {
+    let n_box = 2 * boxed.len();
+    let mut entries: Vec<(usize, usize)> = boxed
+        .iter()
+        .enumerate()
+        .flat_map(|(k, &j)| [(2 * k, j), (2 * k + 1, j)])
+        .collect();
+    entries.extend(extra.iter().map(|&(r, c)| (n_box + r, c)));
+    let (pattern, slots) = Pattern::from_entries(n_box + extra_rows, n, &entries)?;
+    let mut qp = Qp::with_p_pattern(pattern, 0, space.len(), |i, j| space.coupled(i, j))?;
+    for (k, slot) in slots[..n_box].iter().enumerate() {
         qp.a_mut()[*slot] = if k % 2 == 0 { 1.0 } else { -1.0 };
     }
-    Ok((qp, slots[2 * n..].to_vec()))
+    Ok((qp, slots[n_box..].to_vec()))
 }

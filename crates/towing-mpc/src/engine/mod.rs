@@ -41,7 +41,7 @@ use std::time::{Duration, Instant};
 
 pub use quad::QuadModel;
 pub use rows::{Block, BlockMut, PairRows, RowSet, SlotRows};
-pub use space::{Channel, InputSpace};
+pub use space::{Channel, InputSpace, ALL_VESSELS};
 pub use trust::{ScpSettings, TrustRegion};
 
 pub(crate) use layout::Layouts;

@@ -14,7 +14,9 @@
 //!   centralized problem's configuration restriction).
 //!
 //! A row of sample `h` has entries for the increments of samples `0..=h` only
-//! (causality). The recorded values live in the block, sized for the largest
+//! (causality). A one-sided row's slack has a box `[0, s_max]` (among the QP's
+//! box rows); a two-sided row's slack needs none (the pair implies `s >= 0`, and
+//! the boxed increments bound it). The recorded values live in the block, sized for the largest
 //! layout; a [`BlockLayout`] maps them onto one QP. A subproblem lists its blocks
 //! in a [`RowSet`]: a new constraint is a new block in that set, recorded where the
 //! subproblem computes its terms.
@@ -28,7 +30,9 @@ use crate::qp::Qp;
 /// `W / SLACK_SCALE`.
 pub(crate) const SLACK_SCALE: f64 = 100.0;
 
-/// Sets box `j` (rows `2 j`: `x_j <= hi`, `2 j + 1`: `-x_j <= -lo`) of a step QP.
+/// Sets box `j` (rows `2 j`: `x <= hi`, `2 j + 1`: `-x <= -lo` of the `j`-th
+/// boxed variable; the increments' boxes come first, `j` = the increment) of a
+/// step QP.
 pub(crate) fn set_box(qp: &mut Qp, j: usize, lo: f64, hi: f64) {
     let b = qp.b_mut();
     b[2 * j] = hi;
@@ -44,9 +48,60 @@ pub(crate) struct BlockLayout {
     first_row: usize,
     /// First slack variable.
     first_slack: usize,
-    /// `A` value slots, row by row, from `offsets[k]`.
+    /// The box of the first slack (boxed slacks only).
+    first_box: usize,
+    /// Per `A` entry of the block, row by row (from `offsets[k]`): its value
+    /// slot and its column (an increment, or a slack).
     a: Vec<usize>,
+    cols: Vec<usize>,
     offsets: Vec<usize>,
+}
+
+/// Which increments a row of a block can touch: those of samples `0..=h`
+/// (causality) whose channel moves a vessel the row involves
+/// ([`super::Channel::moves`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Reach<'a> {
+    /// Per increment, the vessels its channel moves.
+    pub moves: &'a [u8],
+    /// Increments per sample.
+    pub per_step: usize,
+}
+
+impl Reach<'_> {
+    /// The increments a row of sample `h` about `vessels` depends on.
+    fn columns(&self, h: usize, vessels: u8) -> impl Iterator<Item = usize> + '_ {
+        (0..self.per_step * (h + 1)).filter(move |&v| self.moves[v] & vessels != 0)
+    }
+}
+
+/// A block's rows in one layout: sizes and entries, row by row.
+struct Entries {
+    rows: usize,
+    slacks: usize,
+    /// Whether the slacks have boxes.
+    boxed: bool,
+    slots: usize,
+    entries: Vec<(usize, usize)>,
+    offsets: Vec<usize>,
+}
+
+impl Entries {
+    fn new(slots: usize) -> Entries {
+        Entries {
+            rows: 0,
+            slacks: 0,
+            boxed: false,
+            slots,
+            entries: Vec::new(),
+            offsets: vec![0],
+        }
+    }
+
+    /// Ends the entries of one (or a pair of) row(s).
+    fn close_row(&mut self) {
+        self.offsets.push(self.entries.len());
+    }
 }
 
 /// One-sided soft rows with `slots` rows per sample (module docs). Row
@@ -55,11 +110,12 @@ pub(crate) struct BlockLayout {
 pub struct SlotRows {
     slots: usize,
     horizon: usize,
-    per_step: usize,
     n_u: usize,
+    /// The vessels whose states the rows involve (a bit per vessel).
+    vessels: u8,
     /// `W` (per unit of the row).
     penalty: f64,
-    /// Upper bound of a slack (the row's unit); keeps the QP bounded.
+    /// Upper bound of a slack (the row's unit).
     max_slack: f64,
     value: Vec<f64>,
     bound: Vec<f64>,
@@ -68,12 +124,14 @@ pub struct SlotRows {
 }
 
 impl SlotRows {
-    /// `slots` rows per sample over `horizon` samples of `per_step` increments.
+    /// `slots` rows per sample over `horizon` samples of `per_step` increments,
+    /// about the states of `vessels` (a bit per vessel, as
+    /// [`super::Channel::moves`]), penalty `W` on slacks in `[0, max_slack]`.
     #[must_use]
     pub fn new(
         slots: usize,
-        horizon: usize,
-        per_step: usize,
+        (horizon, per_step): (usize, usize),
+        vessels: u8,
         penalty: f64,
         max_slack: f64,
     ) -> SlotRows {
@@ -82,8 +140,8 @@ impl SlotRows {
         SlotRows {
             slots,
             horizon,
-            per_step,
             n_u,
+            vessels,
             penalty,
             max_slack,
             value: vec![0.0; n],
@@ -154,65 +212,57 @@ impl SlotRows {
             .unwrap_or(0)
     }
 
-    /// Slots per sample of the layout for `slots` slots (at most this block's).
-    fn layout_slots(&self, slots: usize) -> usize {
-        slots.min(self.slots)
-    }
-
-    /// Increments in the row of layout row `k` (`m` slots per sample).
-    fn width(&self, m: usize, k: usize) -> usize {
-        self.per_step * (k / m.max(1) + 1)
-    }
-
     /// The recorded row behind layout row `k` of a layout with `m` slots.
     fn source(&self, m: usize, k: usize) -> usize {
         (k / m) * self.slots + k % m
     }
 
-    fn entries(&self, slots: usize, first_row: usize, first_slack: usize) -> Entries {
-        let m = self.layout_slots(slots);
-        let n = m * self.horizon;
-        let mut out = Vec::new();
-        for k in 0..n {
-            for v in 0..self.width(m, k) {
-                out.push((first_row + k, v));
+    /// One row per layout row, its slack boxed.
+    fn entries(
+        &self,
+        slots: usize,
+        reach: Reach<'_>,
+        first_row: usize,
+        first_slack: usize,
+    ) -> Entries {
+        let m = slots.min(self.slots);
+        let mut e = Entries::new(m);
+        for k in 0..m * self.horizon {
+            let row = first_row + k;
+            for v in reach.columns(k / m, self.vessels) {
+                e.entries.push((row, v));
             }
-            out.push((first_row + k, first_slack + k));
+            e.entries.push((row, first_slack + k));
+            e.close_row();
         }
-        Entries {
-            rows: n,
-            slacks: n,
-            slots: m,
-            entries: out,
-        }
+        e.rows = m * self.horizon;
+        e.slacks = m * self.horizon;
+        e.boxed = true;
+        e
     }
 
-    /// Writes the rows of `layout` (inactive rows: `-s <= 0`), the slack boxes and
-    /// their costs into `qp`.
+    /// Writes the rows of `layout` (`-g^T du - s / SC <= v - b`; an inactive one
+    /// `-s / SC <= 0`), the slack boxes and their costs into `qp`.
     fn load(&self, layout: &BlockLayout, qp: &mut Qp) {
         let m = layout.slots;
         for k in 0..m * self.horizon {
             let kf = self.source(m, k);
-            let slots = &layout.a[layout.offsets[k]..layout.offsets[k + 1]];
-            let width = self.width(m, k);
+            let span = layout.offsets[k]..layout.offsets[k + 1];
+            let (slots, cols) = (&layout.a[span.clone()], &layout.cols[span]);
+            let n_inc = slots.len() - 1;
             let active = self.active[kf];
-            let grad = &self.grad[kf * self.n_u..kf * self.n_u + width];
+            let grad = &self.grad[kf * self.n_u..(kf + 1) * self.n_u];
             let a = qp.a_mut();
-            for (slot, g) in slots.iter().zip(grad) {
-                a[*slot] = if active { -g } else { 0.0 };
+            for (slot, &col) in slots[..n_inc].iter().zip(&cols[..n_inc]) {
+                a[*slot] = if active { -grad[col] } else { 0.0 };
             }
-            a[slots[width]] = -1.0 / SLACK_SCALE;
+            a[slots[n_inc]] = -1.0 / SLACK_SCALE;
             qp.b_mut()[layout.first_row + k] = if active {
                 self.value[kf] - self.bound[kf]
             } else {
                 0.0
             };
-            set_box(
-                qp,
-                layout.first_slack + k,
-                0.0,
-                self.max_slack * SLACK_SCALE,
-            );
+            set_box(qp, layout.first_box + k, 0.0, self.max_slack * SLACK_SCALE);
             qp.q_mut()[layout.first_slack + k] = self.penalty / SLACK_SCALE;
         }
     }
@@ -233,39 +283,27 @@ impl SlotRows {
 }
 
 /// Two-sided soft rows `|r_m + g_m^T du| <= s_m` (module docs), each of a given
-/// sample.
+/// sample and about given vessels.
 #[derive(Debug, Clone)]
 pub struct PairRows {
-    /// The sample of each row (its causal width).
-    sample: Vec<usize>,
-    per_step: usize,
+    /// Per row: its sample (its causal width) and the vessels it involves.
+    rows: Vec<(usize, u8)>,
     n_u: usize,
     /// `W` (per unit of the row).
     penalty: f64,
-    /// Upper bound of a slack.
-    max_slack: f64,
     value: Vec<f64>,
     grad: Vec<f64>,
 }
 
 impl PairRows {
-    /// Rows of the given samples, over `n_u = per_step * horizon` increments.
+    /// Rows of the given `(sample, vessels)` over `n_u` increments, penalty `W`.
     #[must_use]
-    pub fn new(
-        sample: Vec<usize>,
-        per_step: usize,
-        horizon: usize,
-        penalty: f64,
-        max_slack: f64,
-    ) -> PairRows {
-        let n = sample.len();
-        let n_u = per_step * horizon;
+    pub fn new(rows: Vec<(usize, u8)>, n_u: usize, penalty: f64) -> PairRows {
+        let n = rows.len();
         PairRows {
-            sample,
-            per_step,
+            rows,
             n_u,
             penalty,
-            max_slack,
             value: vec![0.0; n],
             grad: vec![0.0; n * n_u],
         }
@@ -289,51 +327,41 @@ impl PairRows {
         &self.grad[m * self.n_u..(m + 1) * self.n_u]
     }
 
-    fn width(&self, m: usize) -> usize {
-        self.per_step * (self.sample[m] + 1)
-    }
-
-    fn entries(&self, first_row: usize, first_slack: usize) -> Entries {
-        let n = self.sample.len();
-        let mut out = Vec::new();
-        for m in 0..n {
+    /// Rows `2 m` and `2 m + 1` per row `m`, sharing its slack.
+    fn entries(&self, reach: Reach<'_>, first_row: usize, first_slack: usize) -> Entries {
+        let n = self.rows.len();
+        let mut e = Entries::new(n);
+        for (m, &(h, vessels)) in self.rows.iter().enumerate() {
             for sign in 0..2 {
                 let row = first_row + 2 * m + sign;
-                out.extend((0..self.width(m)).map(|v| (row, v)));
-                out.push((row, first_slack + m));
+                e.entries
+                    .extend(reach.columns(h, vessels).map(|v| (row, v)));
+                e.entries.push((row, first_slack + m));
             }
+            e.close_row();
         }
-        Entries {
-            rows: 2 * n,
-            slacks: n,
-            slots: n,
-            entries: out,
-        }
+        e.rows = 2 * n;
+        e.slacks = n;
+        e
     }
 
-    /// Rows `r + g^T du - s / SC <= 0` and `-(r + g^T du) - s / SC <= 0`, the slack
-    /// boxes and costs.
+    /// Rows `r + g^T du - s / SC <= 0` and `-(r + g^T du) - s / SC <= 0` and the
+    /// slack costs.
     fn load(&self, layout: &BlockLayout, qp: &mut Qp) {
-        let mut at = 0;
-        for m in 0..self.sample.len() {
-            let width = self.width(m);
+        for m in 0..self.rows.len() {
+            let span = layout.offsets[m]..layout.offsets[m + 1];
+            let (slots, cols) = (&layout.a[span.clone()], &layout.cols[span]);
+            let half = slots.len() / 2;
             let grad = &self.grad[m * self.n_u..(m + 1) * self.n_u];
-            for sign in [1.0, -1.0] {
+            for (part, sign) in [1.0, -1.0].into_iter().enumerate() {
+                let (slots, cols) = (&slots[part * half..(part + 1) * half], &cols[..half - 1]);
                 let a = qp.a_mut();
-                for v in 0..width {
-                    a[layout.a[at + v]] = sign * grad[v];
+                for (slot, &col) in slots.iter().zip(cols) {
+                    a[*slot] = sign * grad[col];
                 }
-                a[layout.a[at + width]] = -1.0 / SLACK_SCALE;
-                at += width + 1;
-                let row = layout.first_row + 2 * m + usize::from(sign < 0.0);
-                qp.b_mut()[row] = -sign * self.value[m];
+                a[slots[half - 1]] = -1.0 / SLACK_SCALE;
+                qp.b_mut()[layout.first_row + 2 * m + part] = -sign * self.value[m];
             }
-            set_box(
-                qp,
-                layout.first_slack + m,
-                0.0,
-                self.max_slack * SLACK_SCALE,
-            );
             qp.q_mut()[layout.first_slack + m] = self.penalty / SLACK_SCALE;
         }
     }
@@ -343,7 +371,7 @@ impl PairRows {
     /// 1e-6 each, times `W`) would swamp small steps and keep the trust ratio
     /// near 0.6.
     fn add_predicted_decrease(&self, du: &[f64], acc: &mut f64) {
-        for m in 0..self.sample.len() {
+        for m in 0..self.rows.len() {
             let grad = &self.grad[m * self.n_u..(m + 1) * self.n_u];
             let lin: f64 = self.value[m]
                 + grad
@@ -354,14 +382,6 @@ impl PairRows {
             *acc += self.penalty * (self.value[m].abs() - lin.abs());
         }
     }
-}
-
-/// A block's size and entries in one layout.
-struct Entries {
-    rows: usize,
-    slacks: usize,
-    slots: usize,
-    entries: Vec<(usize, usize)>,
 }
 
 /// A block of a [`RowSet`], by reference.
@@ -412,12 +432,25 @@ pub trait RowSet: std::fmt::Debug {
     }
 }
 
+/// A block placed in one QP: first row (after the boxes), first slack, slots,
+/// its entries' range in [`Placement::entries`] and its row offsets.
+struct Placed {
+    first_row: usize,
+    first_slack: usize,
+    first_box: usize,
+    slots: usize,
+    start: usize,
+    offsets: Vec<usize>,
+}
+
 /// The blocks of a [`RowSet`] placed in one QP.
 pub(crate) struct Placement {
     /// Every block's `(row, column)` entries (rows counted after the box rows).
     pub entries: Vec<(usize, usize)>,
-    /// Per block: first row, first slack, slots per sample, entry count.
-    pub sizes: Vec<[usize; 4]>,
+    /// The variables with a box, in box order: the increments, then the boxed
+    /// slacks.
+    pub boxed: Vec<usize>,
+    blocks: Vec<Placed>,
     /// Extra rows in all (after the box rows).
     pub rows: usize,
     /// Variables in all.
@@ -426,65 +459,67 @@ pub(crate) struct Placement {
 
 /// The layout of every block of `rows` in a QP with `slots` slots per sample,
 /// its rows from extra row `first_row` and its slacks from variable
-/// `first_slack` on.
+/// `first_slack` on (the increments `0..first_slack` are boxed).
 pub(crate) fn layout_entries(
     rows: &impl RowSet,
     slots: usize,
+    reach: Reach<'_>,
     mut first_row: usize,
     mut first_slack: usize,
 ) -> Placement {
     let mut entries = Vec::new();
-    let mut sizes = Vec::new();
+    let mut boxed: Vec<usize> = (0..first_slack).collect();
+    let mut blocks = Vec::new();
     for block in rows.blocks() {
         let e = match block {
-            Block::Slots(s) => s.entries(slots, first_row, first_slack),
-            Block::Pairs(p) => p.entries(first_row, first_slack),
+            Block::Slots(s) => s.entries(slots, reach, first_row, first_slack),
+            Block::Pairs(p) => p.entries(reach, first_row, first_slack),
         };
-        sizes.push([first_row, first_slack, e.slots, e.entries.len()]);
+        blocks.push(Placed {
+            first_row,
+            first_slack,
+            first_box: boxed.len(),
+            slots: e.slots,
+            start: entries.len(),
+            offsets: e.offsets,
+        });
+        if e.boxed {
+            boxed.extend(first_slack..first_slack + e.slacks);
+        }
         first_row += e.rows;
         first_slack += e.slacks;
         entries.extend(e.entries);
     }
     Placement {
         entries,
-        sizes,
+        boxed,
+        blocks,
         rows: first_row,
         variables: first_slack,
     }
 }
 
-/// The [`BlockLayout`]s of [`layout_entries`]' blocks, from the `A` slots of
-/// their entries (`a_slots`, in entry order) and the QP row of extra row 0.
-pub(crate) fn block_layouts(
-    rows: &impl RowSet,
-    sizes: &[[usize; 4]],
-    a_slots: &[usize],
-    extra_row0: usize,
-) -> Vec<BlockLayout> {
-    let mut at = 0;
-    rows.blocks()
-        .zip(sizes)
-        .map(|(block, &[first_row, first_slack, slots, len])| {
-            let a = a_slots[at..at + len].to_vec();
-            at += len;
-            let mut offsets = vec![0];
-            match block {
-                Block::Slots(s) => {
-                    for k in 0..slots * s.horizon {
-                        offsets.push(offsets[k] + s.width(slots, k) + 1);
-                    }
+impl Placement {
+    /// The [`BlockLayout`]s, from the `A` slots of the entries (`a_slots`, in
+    /// entry order) and the QP row of extra row 0.
+    pub(crate) fn block_layouts(&self, a_slots: &[usize], extra_row0: usize) -> Vec<BlockLayout> {
+        self.blocks
+            .iter()
+            .map(|b| {
+                let len = b.offsets.last().copied().unwrap_or(0);
+                let range = b.start..b.start + len;
+                BlockLayout {
+                    slots: b.slots,
+                    first_row: extra_row0 + b.first_row,
+                    first_slack: b.first_slack,
+                    first_box: b.first_box,
+                    a: a_slots[range.clone()].to_vec(),
+                    cols: self.entries[range].iter().map(|e| e.1).collect(),
+                    offsets: b.offsets.clone(),
                 }
-                Block::Pairs(_) => offsets.push(len),
-            }
-            BlockLayout {
-                slots,
-                first_row: extra_row0 + first_row,
-                first_slack,
-                a,
-                offsets,
-            }
-        })
-        .collect()
+            })
+            .collect()
+    }
 }
 
 /// Drops the one-sided rows the boxes imply; returns the slots per sample the

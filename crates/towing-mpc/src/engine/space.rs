@@ -21,7 +21,17 @@ pub struct Channel {
     /// Scale of the trust region (the channel's unit): the step's box is
     /// `radius * trust_scale`.
     pub trust_scale: f64,
+    /// The predicted vessels this channel moves, a bit per vessel
+    /// ([`ALL_VESSELS`] when a subproblem predicts one vessel). Two increments
+    /// whose channels move no common vessel never share a cost term, so `P`
+    /// has no entry for them, and a row about some vessels has entries only for
+    /// the channels that move one of them: the centralized problem's tug 1 and
+    /// tug 2 thrusts are not coupled, which keeps its QP sparse.
+    pub moves: u8,
 }
+
+/// Every vessel: the `moves` of a channel that may affect any predicted state.
+pub const ALL_VESSELS: u8 = u8::MAX;
 
 impl Channel {
     /// A channel without a rate bound.
@@ -32,6 +42,16 @@ impl Channel {
             upper,
             rate: f64::INFINITY,
             trust_scale,
+            moves: ALL_VESSELS,
+        }
+    }
+
+    /// The channel, moving only `vessels`.
+    #[must_use]
+    pub fn moving(self, vessels: u8) -> Channel {
+        Channel {
+            moves: vessels,
+            ..self
         }
     }
 
@@ -93,6 +113,22 @@ impl InputSpace {
     #[must_use]
     pub fn channels(&self) -> &[Channel] {
         &self.channels
+    }
+
+    /// Per increment, the vessels its channel moves.
+    #[must_use]
+    pub fn moves(&self) -> Vec<u8> {
+        (0..self.len())
+            .map(|j| self.channels[j % self.per_step()].moves)
+            .collect()
+    }
+
+    /// Whether increments `i` and `j` can share a cost term (their channels move
+    /// a common vessel).
+    #[must_use]
+    pub fn coupled(&self, i: usize, j: usize) -> bool {
+        let ps = self.per_step();
+        self.channels[i % ps].moves & self.channels[j % ps].moves != 0
     }
 
     /// Flat index of channel `k` of sample `h`.
@@ -227,6 +263,7 @@ mod tests {
                     upper: 3.0,
                     rate: 0.3,
                     trust_scale: 1.0,
+                    moves: ALL_VESSELS,
                 },
                 Channel::bounded(-10.0, 10.0, 10.0),
             ],
