@@ -238,8 +238,11 @@ pub const REAL_PARAMETERS: [RealParameter; 37] = [
         min: 0.0,
         exclusive: false,
         description: "Ship (coordination) weight of the pose error, eq. (13); 1 as Table 3",
-        get: |t| t.ship.weights[0],
-        set: |t, v| t.ship.weights[0] = v,
+        get: |t| t.ship.weight_position,
+        set: |t, v| {
+            t.ship.weight_position = v;
+            t.ship.weight_heading = v;
+        },
     },
     RealParameter {
         name: "w_S2",
@@ -247,8 +250,11 @@ pub const REAL_PARAMETERS: [RealParameter; 37] = [
         min: 0.0,
         exclusive: false,
         description: "Ship (coordination) weight of the velocity, eq. (13); 75 as Table 3",
-        get: |t| t.ship.weights[1],
-        set: |t, v| t.ship.weights[1] = v,
+        get: |t| t.ship.weight_surge,
+        set: |t, v| {
+            t.ship.weight_surge = v;
+            t.ship.weight_sway = v;
+        },
     },
     RealParameter {
         name: "w_S3",
@@ -256,8 +262,8 @@ pub const REAL_PARAMETERS: [RealParameter; 37] = [
         min: 0.0,
         exclusive: false,
         description: "Ship (coordination) weight of the obstacle distance cost, eq. (13); 1 as Table 3 (forced to 0 by avoidance_scheme 2)",
-        get: |t| t.ship.weights[2],
-        set: |t, v| t.ship.weights[2] = v,
+        get: |t| t.ship.weight_distance,
+        set: |t, v| t.ship.weight_distance = v,
     },
     RealParameter {
         name: "w_T1",
@@ -265,8 +271,11 @@ pub const REAL_PARAMETERS: [RealParameter; 37] = [
         min: 0.0,
         exclusive: false,
         description: "Tug weight of the pose error, eq. (15); 1 as Table 3",
-        get: |t| t.tug.weights[0],
-        set: |t, v| t.tug.weights[0] = v,
+        get: |t| t.tug.weight_position,
+        set: |t, v| {
+            t.tug.weight_position = v;
+            t.tug.weight_heading = v;
+        },
     },
     RealParameter {
         name: "w_T2",
@@ -274,8 +283,12 @@ pub const REAL_PARAMETERS: [RealParameter; 37] = [
         min: 0.0,
         exclusive: false,
         description: "Tug weight of the velocity, eq. (15); 6 as Table 3",
-        get: |t| t.tug.weights[1],
-        set: |t, v| t.tug.weights[1] = v,
+        get: |t| t.tug.weight_surge,
+        set: |t, v| {
+            t.tug.weight_surge = v;
+            t.tug.weight_sway = v;
+            t.tug.weight_yaw_rate = v;
+        },
     },
     RealParameter {
         name: "w_T3",
@@ -283,8 +296,8 @@ pub const REAL_PARAMETERS: [RealParameter; 37] = [
         min: 0.0,
         exclusive: false,
         description: "Tug weight of the obstacle distance cost, eq. (15); 1 as Table 3 (forced to 0 by avoidance_scheme 2)",
-        get: |t| t.tug.weights[2],
-        set: |t, v| t.tug.weights[2] = v,
+        get: |t| t.tug.weight_distance,
+        set: |t, v| t.tug.weight_distance = v,
     },
     RealParameter {
         name: "eps_abs",
@@ -328,8 +341,8 @@ pub const REAL_PARAMETERS: [RealParameter; 37] = [
         min: 0.0,
         exclusive: true,
         description: "Largest tension change per second, eq. (21); the MPC bounds the change per sample by tension_rate * sample_time; 0.3 N per 1 s sample as Table 3",
-        get: |t| t.ship.tension_rate / t.prediction.sample_time,
-        set: |t, v| t.ship.tension_rate = v * t.prediction.sample_time,
+        get: |t| t.ship.tension_rate,
+        set: |t, v| t.ship.tension_rate = v,
     },
     RealParameter {
         name: "angle_rate",
@@ -337,8 +350,8 @@ pub const REAL_PARAMETERS: [RealParameter; 37] = [
         min: 0.0,
         exclusive: true,
         description: "Largest towing-angle change per second, eq. (20); the MPC bounds the change per sample by angle_rate * sample_time; 5 deg per 1 s sample as Table 3",
-        get: |t| t.ship.angle_rate / t.prediction.sample_time,
-        set: |t, v| t.ship.angle_rate = v * t.prediction.sample_time,
+        get: |t| t.ship.angle_rate,
+        set: |t, v| t.ship.angle_rate = v,
     },
     RealParameter {
         name: "max_thrust_surge",
@@ -440,8 +453,8 @@ pub const REAL_PARAMETERS: [RealParameter; 37] = [
         min: 0.0,
         exclusive: false,
         description: "Weight w_alpha (1/rad^2) of the towing angles' squares, a regulariser the paper does not have: without it the angles drift while the lines are slack (docs/assumptions.md); 0 reproduces eq. (13)",
-        get: |t| t.ship.angle_weight,
-        set: |t, v| t.ship.angle_weight = v,
+        get: |t| t.ship.weight_towing_angle,
+        set: |t, v| t.ship.weight_towing_angle = v,
     },
     RealParameter {
         name: "tension_weight",
@@ -449,8 +462,8 @@ pub const REAL_PARAMETERS: [RealParameter; 37] = [
         min: 0.0,
         exclusive: false,
         description: "Weight w_F (1/N^2) of the tensions' squares, a regulariser the paper does not have: it picks the least tension among equal-cost plans instead of a tug of war (docs/assumptions.md); 0 reproduces eq. (13)",
-        get: |t| t.ship.tension_weight,
-        set: |t, v| t.ship.tension_weight = v,
+        get: |t| t.ship.weight_tension,
+        set: |t, v| t.ship.weight_tension = v,
     },
     RealParameter {
         name: "inner_loop_gain_surge",
@@ -485,8 +498,8 @@ pub const REAL_PARAMETERS: [RealParameter; 37] = [
         min: 0.0,
         exclusive: false,
         description: "Weight (s^2/rad^2) of the ship's yaw rate in the velocity term of eq. (13), where the paper uses w_S2 for all three components; with w_S2 = 75 on r and a 3 s horizon the tow turns at about 0.3 deg/s and needs hundreds of seconds per course change (docs/assumptions.md)",
-        get: |t| t.ship.yaw_rate_weight.unwrap_or(t.ship.weights[1]),
-        set: |t, v| t.ship.yaw_rate_weight = Some(v),
+        get: |t| t.ship.weight_yaw_rate,
+        set: |t, v| t.ship.weight_yaw_rate = v,
     },
     RealParameter {
         name: "lookahead",
@@ -530,8 +543,8 @@ pub const REAL_PARAMETERS: [RealParameter; 37] = [
         min: 0.0,
         exclusive: false,
         description: "Weight w_P (1/rad^2) of the one-sided heading term w_P min(0, psi - psi_floor)^2 of the ship's cost; not in the paper; 100 (docs/assumptions.md)",
-        get: |t| t.ship.port_turn_weight,
-        set: |t, v| t.ship.port_turn_weight = v,
+        get: |t| t.ship.weight_port_turn,
+        set: |t, v| t.ship.weight_port_turn = v,
     },
     RealParameter {
         name: "centralized_thrust_rate_weight",
@@ -539,8 +552,11 @@ pub const REAL_PARAMETERS: [RealParameter; 37] = [
         min: 0.0,
         exclusive: false,
         description: "Centralized MPC only (architecture 2): weight (1/N^2, 1/(N m)^2) of the tugs' thrust changes sum |tau_h - tau_h-1|^2, not in the paper; without it the tugs' thrusts, slaved to the ship's plan by the configuration restriction, alternate from sample to sample and grow; 0.01 (docs/assumptions.md)",
-        get: |t| t.centralized.thrust_rate_weight,
-        set: |t, v| t.centralized.thrust_rate_weight = v,
+        get: |t| t.centralized.weight_force_rate,
+        set: |t, v| {
+            t.centralized.weight_force_rate = v;
+            t.centralized.weight_moment_rate = v;
+        },
     },
 ];
 

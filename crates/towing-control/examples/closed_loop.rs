@@ -129,10 +129,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
     if let Some(v) = env("W_F") {
-        config.ship.tension_weight = v;
+        config.ship.weight_tension = v;
     }
     if let Some(v) = env("W_A") {
-        config.ship.angle_weight = v;
+        config.ship.weight_towing_angle = v;
     }
     if let Some(v) = env("F_MIN") {
         config.ship.min_tension = v;
@@ -150,16 +150,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         config.tracking.lookahead = v;
     }
     if let Some(v) = env("W_S1") {
-        config.ship.weights[0] = v;
+        config.ship.weight_position = v;
+        config.ship.weight_heading = v;
     }
     if let Some(v) = env("W_S2") {
-        config.ship.weights[1] = v;
+        config.ship.weight_surge = v;
+        config.ship.weight_sway = v;
     }
     if let Some(v) = env("W_T2") {
-        config.tug.weights[1] = v;
+        config.tug.weight_surge = v;
+        config.tug.weight_sway = v;
+        config.tug.weight_yaw_rate = v;
     }
     if let Some(v) = env("W_R") {
-        config.ship.yaw_rate_weight = Some(v);
+        config.ship.weight_yaw_rate = v;
     }
     if let Some(v) = env("ARCH") {
         config.architecture = towing_control::Architecture::from_code(v as i32)?;
@@ -187,13 +191,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         config.tug.trust_scale[2] = v;
     }
     if let Some(v) = env("PT_W") {
-        config.ship.port_turn_weight = v;
+        config.ship.weight_port_turn = v;
     }
     if let Some(v) = env("PT_M") {
         config.tracking.port_turn_margin = v.to_radians();
     }
     if let Some(v) = env("TUG_RW") {
-        config.centralized.thrust_rate_weight = v;
+        config.centralized.weight_force_rate = v;
+        config.centralized.weight_moment_rate = v;
     }
     if let Some(v) = env("CENT_IT") {
         config.centralized.max_iterations = v as usize;

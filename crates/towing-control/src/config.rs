@@ -271,11 +271,15 @@ impl ControllerConfig {
             ("give_way_lookahead", self.tracking.give_way_lookahead),
             ("los_distance", self.tracking.los_distance),
             ("port_turn_margin", self.tracking.port_turn_margin),
-            ("port_turn_weight", self.ship.port_turn_weight),
+            ("port_turn_weight", self.ship.weight_port_turn),
             ("sample_time_budget", self.sample_time_budget),
             (
-                "centralized_thrust_rate_weight",
-                self.centralized.thrust_rate_weight,
+                "centralized_force_rate_weight",
+                self.centralized.weight_force_rate,
+            ),
+            (
+                "centralized_moment_rate_weight",
+                self.centralized.weight_moment_rate,
             ),
         ] {
             if !(v.is_finite() && v >= 0.0) {

@@ -241,8 +241,8 @@ impl Controller {
         let mut ship_params = config.ship;
         let mut tug_params = config.tug;
         if !config.scheme.distance_cost() {
-            ship_params.weights[2] = 0.0;
-            tug_params.weights[2] = 0.0;
+            ship_params.weight_distance = 0.0;
+            tug_params.weight_distance = 0.0;
         }
         let solver = build_optimizer(&config, ship_params, tug_params)?;
         let s = &config.scenario;
@@ -586,6 +586,8 @@ impl Controller {
     /// zero at their rate bounds, no thrust; the tow then drifts to a stop.
     fn fallback_command(&mut self) -> (ShipInput, [TugInput; 2]) {
         let p = &self.config.ship;
+        let ts = self.config.prediction.sample_time;
+        let (tension_step, angle_step) = (p.tension_rate * ts, p.angle_rate * ts);
         let prev = self.applied.ship;
         let have_spare = self.spare_left > 0;
         self.spare_left = self.spare_left.saturating_sub(1);
@@ -596,11 +598,11 @@ impl Controller {
         };
         let mut ship = [0.0; 4];
         for i in 0..2 {
-            let lo = (prev[i] - p.tension_rate).max(p.min_tension);
-            let hi = (prev[i] + p.tension_rate).min(p.max_tension);
+            let lo = (prev[i] - tension_step).max(p.min_tension);
+            let hi = (prev[i] + tension_step).min(p.max_tension);
             ship[i] = finite_or(wanted[i], prev[i]).clamp(lo.min(hi), hi);
-            let lo = (prev[2 + i] - p.angle_rate).max(-p.max_angle);
-            let hi = (prev[2 + i] + p.angle_rate).min(p.max_angle);
+            let lo = (prev[2 + i] - angle_step).max(-p.max_angle);
+            let hi = (prev[2 + i] + angle_step).min(p.max_angle);
             ship[2 + i] = finite_or(wanted[2 + i], prev[2 + i]).clamp(lo.min(hi), hi);
         }
         let tugs = std::array::from_fn(|i| {

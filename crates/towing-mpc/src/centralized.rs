@@ -131,11 +131,12 @@ pub struct CentralizedSettings {
     pub consensus_penalty: f64,
     /// Trust region (scales: the subproblems' `trust_scale`).
     pub scp: ScpSettings,
-    /// `w_dtau`: weight of the tugs' thrust changes
-    /// `sum_i sum_h |tau_ih - tau_ih-1|^2` (per N^2 and (N m)^2), `tau_i,-1` the
-    /// thrust applied in the previous sample; see [`crate::costs`]
-    /// (`thrust_rate_terms`).
-    pub thrust_rate_weight: f64,
+    /// `w_F`: weight of the tugs' force changes `sum_i sum_h (X_ih - X_ih-1)^2 +
+    /// (Y_ih - Y_ih-1)^2` (1/N^2), `tau_i,-1` the thrust applied in the previous
+    /// sample; see [`crate::costs`] (`thrust_rate_terms`).
+    pub weight_force_rate: f64,
+    /// `w_M`: the same for the yaw moment changes (1/(N m)^2).
+    pub weight_moment_rate: f64,
 }
 
 impl Default for CentralizedSettings {
@@ -146,7 +147,8 @@ impl Default for CentralizedSettings {
             cost_tolerance: 1e-5,
             consensus_penalty: 1e3,
             scp: ScpSettings::default(),
-            thrust_rate_weight: 0.01,
+            weight_force_rate: 0.01,
+            weight_moment_rate: 0.01,
         }
     }
 }
@@ -180,11 +182,13 @@ impl CentralizedSettings {
                 return bad(field, format!("must be finite and >= 0, got {v}"));
             }
         }
-        if !(self.thrust_rate_weight.is_finite() && self.thrust_rate_weight >= 0.0) {
-            return bad(
-                "thrust_rate_weight",
-                format!("must be finite and >= 0, got {}", self.thrust_rate_weight),
-            );
+        for (field, v) in [
+            ("weight_force_rate", self.weight_force_rate),
+            ("weight_moment_rate", self.weight_moment_rate),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(field, format!("must be finite and >= 0, got {v}"));
+            }
         }
         self.scp.validate()
     }
@@ -428,7 +432,7 @@ impl CentralProblem {
             quad,
             input.obstacles,
             &sp.distance,
-            sp.weights[2],
+            sp.weight_distance,
             &sp.clearance,
             clearance,
             h,
@@ -449,6 +453,7 @@ impl CentralProblem {
         input: &SampleInput<'_>,
     ) -> CostBreakdown {
         let tp = &self.tug_params;
+        let (wp, wv) = tp.state_weights();
         let (sens, mut rows_out) = match lin {
             Some((s, r)) => (Some(s), Some(r)),
             None => (None, None),
@@ -492,13 +497,17 @@ impl CentralProblem {
                     if let Some(r) = rows_out.as_deref_mut() {
                         r.consensus.record(m, res[c], &row);
                     }
-                    quad.residual(res[c], tp.weights[0], 0.0, &row);
-                    quad.residual(g[3 + c], tp.weights[1], 0.0, &rows[3 + c]);
+                    quad.residual(res[c], wp[c], 0.0, &row);
+                    quad.residual(g[3 + c], wv[c], 0.0, &rows[3 + c]);
                 }
                 if h == 0 {
                     thrust_rate_terms::<NU>(
                         quad,
-                        self.settings.thrust_rate_weight,
+                        [
+                            self.settings.weight_force_rate,
+                            self.settings.weight_force_rate,
+                            self.settings.weight_moment_rate,
+                        ],
                         &plan.tugs[i],
                         input.previous.tugs[i],
                         |h, c| tug_var(i, h, c),
@@ -508,7 +517,7 @@ impl CentralProblem {
                     quad,
                     input.obstacles,
                     &tp.distance,
-                    tp.weights[2],
+                    tp.weight_distance,
                     &tp.clearance,
                     rows_out.as_deref_mut().map(|r| &mut r.clearance[1 + i]),
                     h,
@@ -685,7 +694,7 @@ impl Centralized {
             }
         }
         settings.validate()?;
-        let mut channels = ship_params.channels().to_vec();
+        let mut channels = ship_params.channels(ship.params().sample_time).to_vec();
         for tug in TUG {
             channels.extend(tug_params.channels().map(|c| c.moving(tug)));
         }

@@ -143,12 +143,11 @@ pub(crate) fn ship_stage_terms<const N: usize>(
     last: bool,
     heading_floor: Option<f64>,
 ) {
-    let [w1, w2, _] = params.weights;
     if let Some(floor) = heading_floor {
         // One-sided: zero (with its gradient) at or to starboard of the floor.
         let e = angle_difference(x[2], floor);
         if e < 0.0 {
-            quad.curved(e * e, 2.0 * e, 2.0, params.port_turn_weight, &rows[2]);
+            quad.curved(e * e, 2.0 * e, 2.0, params.weight_port_turn, &rows[2]);
         }
     }
     let err = [
@@ -156,16 +155,25 @@ pub(crate) fn ship_stage_terms<const N: usize>(
         x[1] - reference[1],
         angle_difference(x[2], reference[2]),
     ];
-    let wv = [w2, w2, params.yaw_rate_weight.unwrap_or(w2)];
+    let wp = [
+        params.weight_position,
+        params.weight_position,
+        params.weight_heading,
+    ];
+    let wv = [
+        params.weight_surge,
+        params.weight_sway,
+        params.weight_yaw_rate,
+    ];
     for c in 0..3 {
-        quad.residual(err[c], w1, 0.0, &rows[c]);
+        quad.residual(err[c], wp[c], 0.0, &rows[c]);
         quad.residual(x[3 + c], wv[c], 0.0, &rows[3 + c]);
     }
     let wu = [
-        params.tension_weight,
-        params.tension_weight,
-        params.angle_weight,
-        params.angle_weight,
+        params.weight_tension,
+        params.weight_tension,
+        params.weight_towing_angle,
+        params.weight_towing_angle,
     ];
     for (k, w) in wu.into_iter().enumerate() {
         if w > 0.0 {
@@ -211,7 +219,8 @@ fn terminal_terms<const N: usize>(
     }
 }
 
-/// `w sum_h |tau_h - tau_h-1|^2` over one tug's plan, `tau_-1 = previous`, with
+/// `sum_h sum_c w_c (tau_hc - tau_h-1,c)^2` over one tug's plan (`w = [w_F, w_F,
+/// w_M]`: the forces' and the moment's weights), `tau_-1 = previous`, with
 /// `column(h, c)` the increment variable of channel `c` of sample `h` (the
 /// variables are increments of the plan, so the rows are unit vectors).
 ///
@@ -234,17 +243,14 @@ fn terminal_terms<const N: usize>(
 /// to 0).
 pub(crate) fn thrust_rate_terms<const N: usize>(
     quad: &mut QuadModel,
-    weight: f64,
+    weight: [f64; 3],
     plan: &[TugInput; HORIZON],
     previous: TugInput,
     column: impl Fn(usize, usize) -> usize,
 ) {
-    if weight <= 0.0 {
-        return;
-    }
     for h in 0..HORIZON {
         let before = if h == 0 { previous } else { plan[h - 1] };
-        for c in 0..3 {
+        for c in (0..3).filter(|&c| weight[c] > 0.0) {
             let mut row = [0.0; N];
             if !quad.value_only {
                 row[column(h, c)] = 1.0;
@@ -252,7 +258,7 @@ pub(crate) fn thrust_rate_terms<const N: usize>(
                     row[column(h - 1, c)] = -1.0;
                 }
             }
-            quad.residual(plan[h][c] - before[c], weight, 0.0, &row);
+            quad.residual(plan[h][c] - before[c], weight[c], 0.0, &row);
         }
     }
 }

@@ -32,7 +32,7 @@ pub struct MpcReport {
 }
 
 /// An MPC architecture (module docs).
-pub trait Optimizer: std::fmt::Debug {
+pub trait Optimizer: std::fmt::Debug + Send {
     /// Solves one control sample within `budget`.
     fn solve(&mut self, input: &SampleInput<'_>, budget: Budget) -> MpcReport;
     /// The ship's plan `[F_1, F_2, alpha_1, alpha_2]` per sample.

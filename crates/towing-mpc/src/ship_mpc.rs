@@ -46,11 +46,20 @@ const N: usize = 4 * HORIZON;
 /// Parameters of the coordination problem.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShipMpcParams {
-    /// `w_S = (w_S1, w_S2, w_S3)`: pose error, velocity, distance (Table 3: 1, 75, 1).
-    pub weights: [f64; 3],
-    /// Weight of the yaw rate in the velocity term (s^2/rad^2); `None` uses
-    /// `w_S2` as eq. (13) does for all three components of `nu`.
-    pub yaw_rate_weight: Option<f64>,
+    /// `w_S1` on the position error `x, y` (1/m^2), eq. (13) (Table 3: 1).
+    pub weight_position: f64,
+    /// `w_S1` on the heading error (1/rad^2), eq. (13) (Table 3: 1).
+    pub weight_heading: f64,
+    /// `w_S2` on the surge speed `u` (s^2/m^2), eq. (13) (Table 3: 75).
+    pub weight_surge: f64,
+    /// `w_S2` on the sway speed `v` (s^2/m^2), eq. (13) (Table 3: 75).
+    pub weight_sway: f64,
+    /// `w_S2` on the yaw rate `r` (s^2/rad^2), eq. (13) (Table 3: 75); the
+    /// paper weights all three components of `nu` alike.
+    pub weight_yaw_rate: f64,
+    /// `w_S3` on the distance cost `phi` (m^2, as `phi` is in 1/m^2), eq. (13)
+    /// (Table 3: 1).
+    pub weight_distance: f64,
     /// `F_min` (N), eq. (18), where the paper has 0: a pretension keeping both
     /// lines taut. With slack lines the formation (eq. (4)-(6)) no longer fixes
     /// the tugs, the towing angles drift with them, and the next pull starts
@@ -60,22 +69,24 @@ pub struct ShipMpcParams {
     pub max_tension: f64,
     /// `alpha_max` (rad), eq. (17).
     pub max_angle: f64,
-    /// `|Delta F|` per sample (N), eq. (21).
+    /// Largest tension change per second (N/s), eq. (21) (Table 3: 0.3 N per
+    /// 1 s sample); the bound of a sample is `tension_rate * T_s`.
     pub tension_rate: f64,
-    /// `|Delta alpha|` per sample (rad), eq. (20).
+    /// Largest towing-angle change per second (rad/s), eq. (20) (Table 3: 5 deg
+    /// per 1 s sample); the bound of a sample is `angle_rate * T_s`.
     pub angle_rate: f64,
     /// `w_alpha` (1/rad^2): weight of `sum_h alpha_ih^2`, a regulariser the paper
     /// does not have. Without it the towing angles are free whenever the
     /// tensions are zero (they then move only the tugs' references), drift with
     /// the tugs to the bounds, and the next pull starts from a crooked formation
     /// (`docs/assumptions.md`). 0 reproduces eq. (13) as printed.
-    pub angle_weight: f64,
+    pub weight_towing_angle: f64,
     /// `w_F` (1/N^2): weight of `sum_h F_ih^2`, a regulariser the paper does not
     /// have. Eq. (13) has no input cost, so equal and opposite tensions cost
     /// nothing and the lines can end in a tug of war at `F_max`; a small `w_F`
     /// picks the least tension among plans of (nearly) equal cost. 0 reproduces
     /// eq. (13) as printed.
-    pub tension_weight: f64,
+    pub weight_tension: f64,
     /// Optional terminal term, not in the paper (`docs/assumptions.md`).
     pub terminal: Option<TerminalCost>,
     /// Trust-region scale of `(F, alpha)` (N, rad): the box is `radius * scale`.
@@ -90,21 +101,25 @@ pub struct ShipMpcParams {
     /// (per rad^2), active only when the sample carries a heading floor
     /// ([`ShipStepData::heading_floor`]). Not in the paper: see
     /// [`crate::costs`].
-    pub port_turn_weight: f64,
+    pub weight_port_turn: f64,
 }
 
 impl Default for ShipMpcParams {
     fn default() -> Self {
         ShipMpcParams {
-            weights: [1.0, 75.0, 1.0],
-            yaw_rate_weight: None,
+            weight_position: 1.0,
+            weight_heading: 1.0,
+            weight_surge: 75.0,
+            weight_sway: 75.0,
+            weight_yaw_rate: 75.0,
+            weight_distance: 1.0,
             min_tension: 0.1,
             max_tension: 3.0,
             max_angle: 30f64.to_radians(),
             tension_rate: 0.3,
             angle_rate: 5f64.to_radians(),
-            angle_weight: 0.0,
-            tension_weight: 0.01,
+            weight_towing_angle: 0.0,
+            weight_tension: 0.01,
             terminal: Some(TerminalCost {
                 weight: 1.0,
                 horizon: 10.0,
@@ -113,7 +128,7 @@ impl Default for ShipMpcParams {
             scp: ScpSettings::default(),
             distance: DistanceCost::default(),
             clearance: ClearanceParams::with_min_distance(0.75),
-            port_turn_weight: 100.0,
+            weight_port_turn: 100.0,
         }
     }
 }
@@ -133,22 +148,32 @@ pub struct TerminalCost {
 }
 
 impl ShipMpcParams {
-    /// `(lower, upper, rate)` of channel `k` (0, 1: tensions; 2, 3: angles):
-    /// eq. (17)-(18) and (20)-(21).
+    /// `(lower, upper, largest change per sample)` of channel `k` (0, 1:
+    /// tensions; 2, 3: angles) for samples of `sample_time` s: eq. (17)-(18)
+    /// and (20)-(21).
     #[must_use]
-    pub fn channel_limits(&self, k: usize) -> (f64, f64, f64) {
+    pub fn channel_limits(&self, k: usize, sample_time: f64) -> (f64, f64, f64) {
         if k < 2 {
-            (self.min_tension, self.max_tension, self.tension_rate)
+            (
+                self.min_tension,
+                self.max_tension,
+                self.tension_rate * sample_time,
+            )
         } else {
-            (-self.max_angle, self.max_angle, self.angle_rate)
+            (
+                -self.max_angle,
+                self.max_angle,
+                self.angle_rate * sample_time,
+            )
         }
     }
 
-    /// The four input channels of a sample (`F_1, F_2, alpha_1, alpha_2`).
+    /// The four input channels of a sample (`F_1, F_2, alpha_1, alpha_2`) for
+    /// samples of `sample_time` s.
     #[must_use]
-    pub fn channels(&self) -> [Channel; 4] {
+    pub fn channels(&self, sample_time: f64) -> [Channel; 4] {
         std::array::from_fn(|k| {
-            let (lower, upper, rate) = self.channel_limits(k);
+            let (lower, upper, rate) = self.channel_limits(k, sample_time);
             Channel {
                 lower,
                 upper,
@@ -159,10 +184,11 @@ impl ShipMpcParams {
         })
     }
 
-    /// Projects `plan` onto the bounds and the rate bounds, sample by sample,
-    /// the first measured from `previous` (itself clamped to the bounds).
-    pub fn project(&self, plan: &mut [ShipInput; HORIZON], previous: &ShipInput) {
-        let space = InputSpace::new(self.channels().to_vec(), HORIZON);
+    /// Projects `plan` (samples of `sample_time` s) onto the bounds and the rate
+    /// bounds, sample by sample, the first measured from `previous` (itself
+    /// clamped to the bounds).
+    pub fn project(&self, plan: &mut [ShipInput; HORIZON], previous: &ShipInput, sample_time: f64) {
+        let space = InputSpace::new(self.channels(sample_time).to_vec(), HORIZON);
         space.project(plan.as_flattened_mut(), previous);
     }
 }
@@ -234,7 +260,10 @@ impl ShipProblem {
     #[must_use]
     pub fn new(model: ShipModel, formation: FormationMap, params: ShipMpcParams) -> ShipProblem {
         ShipProblem {
-            space: InputSpace::new(params.channels().to_vec(), HORIZON),
+            space: InputSpace::new(
+                params.channels(model.params().sample_time).to_vec(),
+                HORIZON,
+            ),
             model,
             formation,
             params,
@@ -387,7 +416,7 @@ fn accumulate(
     mut clearance: Option<&mut SlotRows>,
     data: &ShipStepData<'_>,
 ) {
-    let w3 = params.weights[2];
+    let w3 = params.weight_distance;
     let mut rows = [[0.0; N]; 6];
     for (h, x) in states.iter().enumerate() {
         if let Some(sens) = sens {
@@ -494,12 +523,12 @@ mod tests {
         let tol = 1e-9;
         let mut before = *previous;
         for k in 0..4 {
-            let (lo, hi, _) = mpc.problem().params().channel_limits(k);
+            let (lo, hi, _) = mpc.problem().params().channel_limits(k, 1.0);
             before[k] = before[k].clamp(lo, hi);
         }
         for u in &mpc.inputs() {
             for k in 0..4 {
-                let (lo, hi, rate) = mpc.problem().params().channel_limits(k);
+                let (lo, hi, rate) = mpc.problem().params().channel_limits(k, 1.0);
                 if u[k] < lo - tol || u[k] > hi + tol {
                     return Err(format!("bound {k}: {u:?}"));
                 }
@@ -567,7 +596,7 @@ mod tests {
     fn a_heading_floor_stops_a_turn_to_port() {
         let run = |floor: Option<f64>| {
             let mut mpc = ship_mpc_with(ShipMpcParams {
-                port_turn_weight: 1e4,
+                weight_port_turn: 1e4,
                 ..ShipMpcParams::default()
             });
             let mut data = data_at_rest(&mpc, [1.0, -1.0, -0.5], 0.0);
@@ -627,9 +656,15 @@ mod tests {
             radius: 0.3,
         }];
         let run = |max_obstacles: usize| {
-            let mut params = ShipMpcParams::default();
-            params.weights[2] = 0.0;
-            params.clearance.max_obstacles = max_obstacles;
+            let defaults = ShipMpcParams::default();
+            let params = ShipMpcParams {
+                weight_distance: 0.0,
+                clearance: ClearanceParams {
+                    max_obstacles,
+                    ..defaults.clearance
+                },
+                ..defaults
+            };
             let mut mpc = ship_mpc_with(params);
             let mut data = data_at_rest(&mpc, [3.0, 0.0, 0.0], 0.0);
             data.obstacles = &obstacles;

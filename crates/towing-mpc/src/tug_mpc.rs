@@ -42,8 +42,18 @@ const N: usize = 3 * HORIZON;
 /// Parameters of a tug's local problem.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TugMpcParams {
-    /// `w_i = (w_1, w_2, w_3)`: pose error, velocity, distance cost (Table 3: 1, 6, 1).
-    pub weights: [f64; 3],
+    /// `w_i1` on the position error `x, y` (1/m^2), eq. (16) (Table 3: 1).
+    pub weight_position: f64,
+    /// `w_i1` on the heading error (1/rad^2), eq. (16) (Table 3: 1).
+    pub weight_heading: f64,
+    /// `w_i2` on the surge speed (s^2/m^2), eq. (16) (Table 3: 6).
+    pub weight_surge: f64,
+    /// `w_i2` on the sway speed (s^2/m^2), eq. (16) (Table 3: 6).
+    pub weight_sway: f64,
+    /// `w_i2` on the yaw rate (s^2/rad^2), eq. (16) (Table 3: 6).
+    pub weight_yaw_rate: f64,
+    /// `w_i3` on the distance cost `phi` (m^2), eq. (16) (Table 3: 1).
+    pub weight_distance: f64,
     /// `|X|, |Y|, |N|` limits (N, N, N m), eq. (19).
     pub thrust_limit: [f64; 3],
     /// Per-variable trust-region scale (N, N, N m): the box is `radius * scale`.
@@ -60,7 +70,12 @@ pub struct TugMpcParams {
 impl Default for TugMpcParams {
     fn default() -> Self {
         TugMpcParams {
-            weights: [1.0, 6.0, 1.0],
+            weight_position: 1.0,
+            weight_heading: 1.0,
+            weight_surge: 6.0,
+            weight_sway: 6.0,
+            weight_yaw_rate: 6.0,
+            weight_distance: 1.0,
             thrust_limit: [10.0; 3],
             trust_scale: [10.0, 10.0, 1.0],
             scp: ScpSettings::default(),
@@ -71,6 +86,19 @@ impl Default for TugMpcParams {
 }
 
 impl TugMpcParams {
+    /// The pose-error weights `[x, y, psi]` and the velocity weights `[u, v, r]`.
+    #[must_use]
+    pub fn state_weights(&self) -> ([f64; 3], [f64; 3]) {
+        (
+            [
+                self.weight_position,
+                self.weight_position,
+                self.weight_heading,
+            ],
+            [self.weight_surge, self.weight_sway, self.weight_yaw_rate],
+        )
+    }
+
     /// The three input channels of a sample (`X, Y, N`): bounded, no rate bound.
     #[must_use]
     pub fn channels(&self) -> [Channel; 3] {
@@ -279,7 +307,8 @@ fn accumulate(
     mut clearance: Option<&mut SlotRows>,
     data: &TugStepData<'_>,
 ) {
-    let [w1, w2, w3] = params.weights;
+    let (wp, wv) = params.state_weights();
+    let w3 = params.weight_distance;
     let mut rows = [[0.0; N]; 6];
     for (h, x) in states.iter().enumerate() {
         if let Some(sens) = sens {
@@ -295,8 +324,8 @@ fn accumulate(
         let f = data.reference[h];
         let err = [x[0] - f[0], x[1] - f[1], angle_difference(x[2], f[2])];
         for c in 0..3 {
-            quad.residual(err[c], w1 + 0.5 * data.rho, data.lambda[h][c], &rows[c]);
-            quad.residual(x[3 + c], w2, 0.0, &rows[3 + c]);
+            quad.residual(err[c], wp[c] + 0.5 * data.rho, data.lambda[h][c], &rows[c]);
+            quad.residual(x[3 + c], wv[c], 0.0, &rows[3 + c]);
         }
         obstacle_terms(
             quad,
@@ -430,9 +459,15 @@ mod tests {
             radius: 0.3,
         }];
         let run = |max_obstacles: usize| {
-            let mut params = TugMpcParams::default();
-            params.weights[2] = 0.0;
-            params.clearance.max_obstacles = max_obstacles;
+            let defaults = TugMpcParams::default();
+            let params = TugMpcParams {
+                weight_distance: 0.0,
+                clearance: ClearanceParams {
+                    max_obstacles,
+                    ..defaults.clearance
+                },
+                ..defaults
+            };
             let scenario = Scenario::paper().unwrap();
             let model = TugModel::from_scenario(
                 &scenario,

@@ -88,7 +88,8 @@ fn tight_settings() -> CentralizedSettings {
         cost_tolerance: 0.0,
         // The same problem as the ADMM's (no move suppression, see
         // `thrust_rate_terms`).
-        thrust_rate_weight: 0.0,
+        weight_force_rate: 0.0,
+        weight_moment_rate: 0.0,
         ..CentralizedSettings::default()
     }
 }
