@@ -14,6 +14,9 @@
 //! - [`towline`]: the two towlines, forces from geometry (tension along the line,
 //!   moment `r x F`), ideal winch or elastic line ([`TowlineModel`]).
 //! - [`traffic`]: static hazards and target ships, moved analytically.
+//! - [`state`]: a pose ([`Pose`]) and a vessel's pose and velocity ([`VesselState`]);
+//!   [`config`]: the physics configuration ([`WorldConfig`]). The scenario and the world
+//!   both use them; the world reads the scenario, never the other way round.
 //! - [`world`]: the three vessels and two towlines integrated jointly with RK4
 //!   ([`World`]), atomic steps, state serialisation.
 //! - [`scenario`]: the TOML scenario format ([`Scenario`], `docs/scenario-format.md`);
@@ -51,22 +54,24 @@
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
 pub mod angle;
+pub mod config;
 pub mod kinetics;
 pub mod scenario;
+pub mod state;
 pub mod towline;
 pub mod traffic;
 pub mod vessel;
 pub mod world;
 
 pub use angle::wrap_angle;
+pub use config::WorldConfig;
 pub use kinetics::{HullDynamics, HullModel, LinearDampingHull, NonlinearDampingHull};
-pub use scenario::{
-    Pose, Route, Scenario, ScenarioError, ScenarioErrorKind, TugPlacement, Waterway,
-};
+pub use scenario::{Route, Scenario, ScenarioError, ScenarioErrorKind, TugPlacement, Waterway};
+pub use state::{Pose, VesselState};
 pub use towline::{ElasticTowlineParams, TowlineModel, TowlineOutput};
 pub use traffic::{Obstacle, ObstacleOutput, ObstacleShape};
 pub use vessel::{Damping, ParamError, TitoNeriDampingSet, VesselData};
-pub use world::{StepError, VesselState, World, WorldConfig, WorldError, WorldInputs};
+pub use world::{StepError, World, WorldError, WorldInputs};
 
 /// Number of obstacle output slots of the world (and of the plant FMU's
 /// `obstacle[k].*` outputs, k = 1..8). A scenario with more obstacles is refused.

@@ -16,13 +16,15 @@ use serde::Deserialize;
 use toml::de::{DeTable, DeValue};
 
 use crate::angle::wrap_angle;
+use crate::config::WorldConfig;
 use crate::kinetics::HullModel;
+pub use crate::state::Pose;
+use crate::state::VesselState;
 use crate::towline::{formation_pose, ElasticTowlineParams, TowlineModel};
 use crate::traffic::{Obstacle, ObstacleShape};
 use crate::vessel::{
     check_finite, check_positive, Damping, ParamError, TitoNeriDampingSet, VesselData,
 };
-use crate::world::{VesselState, WorldConfig};
 use crate::MAX_OBSTACLES;
 
 /// The scenario format version this build reads.
@@ -99,17 +101,6 @@ impl fmt::Display for ScenarioError {
 }
 
 impl std::error::Error for ScenarioError {}
-
-/// A pose on the route: `x` North (m), `y` East (m), `psi` heading (rad).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Pose {
-    /// North (m).
-    pub x: f64,
-    /// East (m).
-    pub y: f64,
-    /// Heading (rad, `(-pi, pi]`).
-    pub psi: f64,
-}
 
 /// The planned route (Du et al. 2022, Table 4): origin, waypoints, destination.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,5 +1,6 @@
 use super::*;
 use crate::kinetics::NonlinearDampingHull;
+use crate::towline::TowlineModel;
 use crate::traffic::{KIND_CIRCLE, KIND_NONE, KIND_VESSEL};
 use nalgebra::Vector3;
 use proptest::prelude::*;
