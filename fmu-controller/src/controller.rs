@@ -30,6 +30,7 @@ use std::path::{Path, PathBuf};
 use towing_control::{
     Architecture, AvoidanceScheme, Command, Controller, ControllerConfig, Measurement, SampleReport,
 };
+use towing_interface::codec::{obstacle_kind_code, obstacle_kind_from_code};
 use towing_interface::ScenarioFile;
 use towing_log::{LogOptions, RunInfo, SharedLog};
 use towing_model::{HullModel, Scenario, MAX_OBSTACLES};
@@ -541,7 +542,9 @@ impl Fmi2Model for ControllerFmu {
             vars::FALLBACKS => o.fallbacks,
             vars::SAMPLES => o.samples,
             vars::ACTIVE_WAYPOINT => o.active_waypoint,
-            1000..=1079 => self.inputs.measurement.obstacles[((vr - 1000) / 10) as usize].kind,
+            1000..=1079 => obstacle_kind_code(
+                self.inputs.measurement.obstacles[((vr - 1000) / 10) as usize].kind,
+            ),
             3100..=3179 => {
                 let slot = ((vr - 3100) / 10) as usize;
                 match (vr - 3100) % 10 {
@@ -561,7 +564,8 @@ impl Fmi2Model for ControllerFmu {
             vars::MAX_ITERATIONS => self.params.max_iterations = value,
             vars::PREDICTION_HORIZON => self.params.prediction_horizon = value,
             1000..=1079 if (vr - 1000) % 10 == vars::OBSTACLE_KIND => {
-                self.inputs.measurement.obstacles[((vr - 1000) / 10) as usize].kind = value;
+                self.inputs.measurement.obstacles[((vr - 1000) / 10) as usize].kind =
+                    obstacle_kind_from_code(value)?;
             }
             _ => return Err(format!("value reference {vr} is not a settable Integer")),
         }

@@ -16,6 +16,7 @@ use crate::variables as vars;
 use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use towing_interface::codec::obstacle_kind_code;
 use towing_interface::ScenarioFile;
 use towing_log::topics::Log;
 use towing_log::{LogOptions, RunInfo, SharedLog};
@@ -353,7 +354,7 @@ impl Fmi2Model for Plant {
             _ => {
                 let slot = (vr.saturating_sub(1000) / 10) as usize;
                 match self.world() {
-                    Some(w) if slot < MAX_OBSTACLES => w.obstacle(slot).kind,
+                    Some(w) if slot < MAX_OBSTACLES => obstacle_kind_code(w.obstacle(slot).kind),
                     _ => 0,
                 }
             }

@@ -13,7 +13,9 @@
 //!   ([`VesselData::cybership2`], [`VesselData::titoneri`]).
 //! - [`towline`]: the two towlines, forces from geometry (tension along the line,
 //!   moment `r x F`), ideal winch or elastic line ([`TowlineModel`]).
-//! - [`traffic`]: static hazards and target ships, moved analytically.
+//! - [`traffic`]: static hazards and target ships ([`TrafficObstacle`]), moved
+//!   analytically, and what an obstacle slot shows at a time ([`ObstacleSlot`], its
+//!   [`ObstacleKind`]).
 //! - [`state`]: a pose ([`Pose`]) and a vessel's pose and velocity ([`VesselState`]);
 //!   [`config`]: the physics configuration ([`WorldConfig`]). The scenario and the world
 //!   both use them; the world reads the scenario, never the other way round.
@@ -46,7 +48,7 @@
 //! assert!(world.ship().nu[0] > 0.0); // the ship is under way
 //! assert_eq!(world.towline(1).tension, 2.0);
 //! let target_a = world.obstacle(3); // at world.time()
-//! assert_eq!(target_a.kind, 2);
+//! assert_eq!(target_a.kind, towing_model::ObstacleKind::VesselEllipse);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 #![forbid(unsafe_code)]
@@ -69,7 +71,7 @@ pub use kinetics::{HullDynamics, HullModel, LinearDampingHull, NonlinearDampingH
 pub use scenario::{Route, Scenario, ScenarioError, ScenarioErrorKind, TugPlacement, Waterway};
 pub use state::{Pose, VesselState};
 pub use towline::{ElasticTowlineParams, TowlineModel, TowlineOutput};
-pub use traffic::{Obstacle, ObstacleOutput, ObstacleShape};
+pub use traffic::{ObstacleKind, ObstacleShape, ObstacleSlot, TrafficObstacle};
 pub use vessel::{Damping, ParamError, TitoNeriDampingSet, VesselData};
 pub use world::{StepError, World, WorldError, WorldInputs};
 

@@ -21,7 +21,7 @@ use crate::kinetics::HullModel;
 pub use crate::state::Pose;
 use crate::state::VesselState;
 use crate::towline::{formation_pose, ElasticTowlineParams, TowlineModel};
-use crate::traffic::{Obstacle, ObstacleShape};
+use crate::traffic::{ObstacleShape, TrafficObstacle};
 use crate::vessel::{
     check_finite, check_positive, Damping, ParamError, TitoNeriDampingSet, VesselData,
 };
@@ -178,7 +178,7 @@ pub struct Scenario {
     /// The waterway, if given.
     pub waterway: Option<Waterway>,
     /// Static hazards and target ships (at most [`MAX_OBSTACLES`]).
-    pub obstacles: Vec<Obstacle>,
+    pub obstacles: Vec<TrafficObstacle>,
     /// Ship parameters (CyberShip II preset with the file's overrides).
     pub ship_data: VesselData,
     /// Tug parameters (TitoNeri preset with the file's overrides).
@@ -860,7 +860,7 @@ fn convert(file: FileScenario, origin: &str) -> Result<Scenario, ScenarioError> 
                 activation_range: o.activation_range,
             },
         };
-        obstacles.push(Obstacle {
+        obstacles.push(TrafficObstacle {
             name: o.name,
             x: o.x,
             y: o.y,

@@ -48,7 +48,7 @@ use crate::towline::{
     self, clamp_command, elastic_params, elastic_tension, geometry_kin, ideal_winch_tension,
     loads_kin, winch_rate, ElasticTowlineParams, Kin, TowlineOutput,
 };
-use crate::traffic::{Obstacle, ObstacleOutput, ObstacleShape};
+use crate::traffic::{ObstacleShape, ObstacleSlot, TrafficObstacle};
 use crate::vessel::{ParamError, VesselData};
 use crate::MAX_OBSTACLES;
 
@@ -148,7 +148,7 @@ pub struct World {
     points: [[f64; 2]; 2],
     winch_max: [f64; 2],
     tau_max: [[f64; 3]; 2],
-    obstacles: Vec<Obstacle>,
+    obstacles: Vec<TrafficObstacle>,
     fingerprint: u64,
     // Dynamic state.
     time: f64,
@@ -300,7 +300,7 @@ impl World {
         let by_time = self
             .obstacles
             .get(slot)
-            .and_then(Obstacle::activation_time)
+            .and_then(TrafficObstacle::activation_time)
             .filter(|&t_a| self.time >= t_a);
         match (by_time, self.activated_at[slot]) {
             (Some(a), Some(b)) => Some(a.min(b)),
@@ -374,7 +374,7 @@ impl World {
 
     /// The obstacles of the scenario (at most [`MAX_OBSTACLES`]).
     #[must_use]
-    pub fn obstacles(&self) -> &[Obstacle] {
+    pub fn obstacles(&self) -> &[TrafficObstacle] {
         &self.obstacles
     }
 
@@ -422,17 +422,17 @@ impl World {
 
     /// Obstacle slot `slot` (0..[`MAX_OBSTACLES`]) at [`World::time`], with the
     /// effective activation ([`World::activation_time`]); slots beyond the
-    /// scenario's obstacles are [`ObstacleOutput::EMPTY`].
+    /// scenario's obstacles are [`ObstacleSlot::EMPTY`].
     ///
     /// # Panics
     /// If `slot >= MAX_OBSTACLES`.
     #[must_use]
-    pub fn obstacle(&self, slot: usize) -> ObstacleOutput {
+    pub fn obstacle(&self, slot: usize) -> ObstacleSlot {
         assert!(
             slot < MAX_OBSTACLES,
             "obstacle slot {slot} out of range (0..{MAX_OBSTACLES})"
         );
-        self.obstacles.get(slot).map_or(ObstacleOutput::EMPTY, |o| {
+        self.obstacles.get(slot).map_or(ObstacleSlot::EMPTY, |o| {
             o.output_activated(self.time, self.activation_time(slot))
         })
     }
