@@ -12,16 +12,19 @@
 //! layer keeps for FMU states share it.
 
 use crate::logging::{self, LogScenario, StepSnapshot};
-use crate::variables as vars;
+use crate::variables::{self as vars, PlantVariable};
+use fmi2_slave::ValueType;
 use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use towing_interface::codec::obstacle_kind_code;
+use towing_interface::codec::{
+    obstacle_kind_code, ContractVariable, ObstacleField, TowlineField, Vessel,
+};
 use towing_interface::ScenarioFile;
 use towing_log::topics::Log;
 use towing_log::{LogOptions, RunInfo, SharedLog};
 use towing_model::{
-    HullModel, Scenario, TowlineModel, World, WorldConfig, WorldInputs, MAX_OBSTACLES,
+    HullModel, ObstacleSlot, Scenario, TowlineModel, TowlineOutput, World, WorldConfig, WorldInputs,
 };
 
 /// Version of [`Plant`]'s serialized state; bump on any layout change.
@@ -286,131 +289,107 @@ impl Fmi2Model for Plant {
         }
     }
 
-    fn get_real(&self, vr: u32) -> f64 {
-        match vr {
-            vars::INTEGRATION_STEP => self.params.integration_step,
-            vars::LOG_SCENE_INTERVAL => self.params.log_scene_interval,
-            200..=299 => {
-                for tug in 0..2 {
-                    for c in 0..3 {
-                        if vr == vars::tug_force(tug, c) {
-                            return self.inputs.tug_tau[tug as usize][c as usize];
-                        }
-                    }
-                }
-                for line in 0..2 {
-                    if vr == vars::tension_cmd(line) {
-                        return self.inputs.tension_cmd[line as usize];
-                    }
-                }
-                f64::NAN
+    fn get_real(&self, vr: u32) -> Result<f64, String> {
+        use ContractVariable as C;
+        Ok(match vars::VARIABLES.decode(ValueType::Real, vr)? {
+            PlantVariable::IntegrationStep => self.params.integration_step,
+            PlantVariable::LogSceneInterval => self.params.log_scene_interval,
+            PlantVariable::Contract(C::TugForce(tug, c)) => {
+                self.inputs.tug_tau[tug.index()][c.index()]
             }
-            _ => self.world().map_or(0.0, |w| output_real(w, vr)),
-        }
+            PlantVariable::Contract(C::TensionCmd(line)) => self.inputs.tension_cmd[line.index()],
+            PlantVariable::Contract(c) => real_output(self.world(), c).ok_or_else(|| {
+                vars::VARIABLES.unhandled(ValueType::Real, PlantVariable::Contract(c), "get")
+            })?,
+            other => return Err(vars::VARIABLES.unhandled(ValueType::Real, other, "get")),
+        })
     }
 
     fn set_real(&mut self, log: &Logger, vr: u32, value: f64) -> Result<(), String> {
-        if vr == vars::LOG_SCENE_INTERVAL {
-            let previous = self.params.log_scene_interval;
-            self.params.log_scene_interval = value;
-            return self.params.validate().inspect_err(|_| {
-                self.params.log_scene_interval = previous;
-            });
-        }
-        if vr == vars::INTEGRATION_STEP {
-            let previous = self.params.clone();
-            self.params.integration_step = value;
-            if let Err(e) = self
-                .params
-                .validate()
-                .and_then(|()| self.reload_if_initializing(log))
-            {
-                self.params = previous;
-                return Err(e);
+        use ContractVariable as C;
+        match vars::VARIABLES.decode(ValueType::Real, vr)? {
+            PlantVariable::LogSceneInterval => {
+                let previous = self.params.log_scene_interval;
+                self.params.log_scene_interval = value;
+                self.params.validate().inspect_err(|_| {
+                    self.params.log_scene_interval = previous;
+                })
             }
-            return Ok(());
-        }
-        for tug in 0..2 {
-            for c in 0..3 {
-                if vr == vars::tug_force(tug, c) {
-                    self.inputs.tug_tau[tug as usize][c as usize] = value;
-                    return Ok(());
-                }
+            PlantVariable::IntegrationStep => {
+                let previous = self.params.clone();
+                self.params.integration_step = value;
+                self.params
+                    .validate()
+                    .and_then(|()| self.reload_if_initializing(log))
+                    .inspect_err(|_| self.params = previous)
             }
-        }
-        for line in 0..2 {
-            if vr == vars::tension_cmd(line) {
-                self.inputs.tension_cmd[line as usize] = value;
-                return Ok(());
+            PlantVariable::Contract(C::TugForce(tug, c)) => {
+                self.inputs.tug_tau[tug.index()][c.index()] = value;
+                Ok(())
             }
+            PlantVariable::Contract(C::TensionCmd(line)) => {
+                self.inputs.tension_cmd[line.index()] = value;
+                Ok(())
+            }
+            _ => Err(format!("value reference {vr} is not a settable Real")),
         }
-        Err(format!("value reference {vr} is not a settable Real"))
     }
 
-    fn get_integer(&self, vr: u32) -> i32 {
-        match vr {
-            vars::HULL_MODEL => self.params.hull_model,
-            vars::TOWLINE_MODEL => self.params.towline_model,
-            _ => {
-                let slot = (vr.saturating_sub(1000) / 10) as usize;
-                match self.world() {
-                    Some(w) if slot < MAX_OBSTACLES => obstacle_kind_code(w.obstacle(slot).kind),
-                    _ => 0,
-                }
-            }
-        }
+    fn get_integer(&self, vr: u32) -> Result<i32, String> {
+        use ContractVariable as C;
+        Ok(match vars::VARIABLES.decode(ValueType::Integer, vr)? {
+            PlantVariable::HullModel => self.params.hull_model,
+            PlantVariable::TowlineModel => self.params.towline_model,
+            PlantVariable::Contract(C::Obstacle(slot, ObstacleField::Kind)) => self
+                .world()
+                .map_or(0, |w| obstacle_kind_code(w.obstacle(slot.index()).kind)),
+            other => return Err(vars::VARIABLES.unhandled(ValueType::Integer, other, "get")),
+        })
     }
 
     fn set_integer(&mut self, log: &Logger, vr: u32, value: i32) -> Result<(), String> {
         let previous = self.params.clone();
-        match vr {
-            vars::HULL_MODEL => self.params.hull_model = value,
-            vars::TOWLINE_MODEL => self.params.towline_model = value,
+        match vars::VARIABLES.decode(ValueType::Integer, vr)? {
+            PlantVariable::HullModel => self.params.hull_model = value,
+            PlantVariable::TowlineModel => self.params.towline_model = value,
             _ => return Err(format!("value reference {vr} is not a settable Integer")),
         }
-        if let Err(e) = self
-            .params
+        self.params
             .validate()
             .and_then(|()| self.reload_if_initializing(log))
-        {
-            self.params = previous;
-            return Err(e);
-        }
-        Ok(())
+            .inspect_err(|_| self.params = previous)
     }
 
-    fn get_boolean(&self, vr: u32) -> bool {
-        for line in 0..2 {
-            if vr == vars::towline(line, vars::TOWLINE_SLACK) {
-                return self.world().is_none_or(|w| w.towline(line as usize).slack);
+    fn get_boolean(&self, vr: u32) -> Result<bool, String> {
+        match vars::VARIABLES.decode(ValueType::Boolean, vr)? {
+            PlantVariable::Contract(ContractVariable::Towline(line, TowlineField::Slack)) => {
+                Ok(self.world().is_none_or(|w| w.towline(line.index()).slack))
             }
+            other => Err(vars::VARIABLES.unhandled(ValueType::Boolean, other, "get")),
         }
-        false
     }
 
     fn set_boolean(&mut self, _log: &Logger, vr: u32, _value: bool) -> Result<(), String> {
+        vars::VARIABLES.decode(ValueType::Boolean, vr)?;
         Err(format!("value reference {vr} is not a settable Boolean"))
     }
 
-    fn get_string(&self, vr: u32) -> String {
-        match vr {
-            vars::SCENARIO => self.params.scenario.clone(),
-            vars::LOG_FILE => self.params.log_file.clone(),
-            _ => String::new(),
+    fn get_string(&self, vr: u32) -> Result<String, String> {
+        match vars::VARIABLES.decode(ValueType::String, vr)? {
+            PlantVariable::Contract(ContractVariable::Scenario) => Ok(self.params.scenario.clone()),
+            PlantVariable::Contract(ContractVariable::LogFile) => Ok(self.params.log_file.clone()),
+            other => Err(vars::VARIABLES.unhandled(ValueType::String, other, "get")),
         }
     }
 
     fn set_string(&mut self, log: &Logger, vr: u32, value: &str) -> Result<(), String> {
-        match vr {
-            vars::SCENARIO => {
+        match vars::VARIABLES.decode(ValueType::String, vr)? {
+            PlantVariable::Contract(ContractVariable::Scenario) => {
                 let previous = std::mem::replace(&mut self.params.scenario, value.to_owned());
-                if let Err(e) = self.reload_if_initializing(log) {
-                    self.params.scenario = previous;
-                    return Err(e);
-                }
-                Ok(())
+                self.reload_if_initializing(log)
+                    .inspect_err(|_| self.params.scenario = previous)
             }
-            vars::LOG_FILE => {
+            PlantVariable::Contract(ContractVariable::LogFile) => {
                 value.clone_into(&mut self.params.log_file);
                 Ok(())
             }
@@ -567,44 +546,33 @@ impl Fmi2Model for Plant {
     }
 }
 
-/// Real outputs read from the world.
-fn output_real(w: &World, vr: u32) -> f64 {
-    match vr {
-        100..=125 => {
-            let vessel = (vr - 100) / 10;
-            let c = ((vr - 100) % 10) as usize;
+/// The Real output `c` of the world (0 before a scenario is loaded); `None` when `c` is not
+/// a Real output of the plant.
+fn real_output(world: Option<&World>, c: ContractVariable) -> Option<f64> {
+    let read = |f: &dyn Fn(&World) -> f64| Some(world.map_or(0.0, f));
+    match c {
+        ContractVariable::VesselState(vessel, component) => read(&|w| {
             let state = match vessel {
-                0 => w.ship(),
-                1 => w.tug(0),
-                _ => w.tug(1),
+                Vessel::Ship => w.ship(),
+                Vessel::Tug1 => w.tug(0),
+                Vessel::Tug2 => w.tug(1),
             };
-            if c < 3 {
-                state.eta[c]
-            } else {
-                state.nu[c - 3]
-            }
+            component.of(state)
+        }),
+        ContractVariable::Towline(line, field) => {
+            let value: fn(&TowlineOutput) -> f64 = match field {
+                TowlineField::Length => |l| l.length,
+                TowlineField::Angle => |l| l.angle,
+                TowlineField::Tension => |l| l.tension,
+                TowlineField::Slack => return None,
+            };
+            read(&|w| value(&w.towline(line.index())))
         }
-        300..=313 => {
-            let line = w.towline(((vr - 300) / 10) as usize);
-            match (vr - 300) % 10 {
-                0 => line.length,
-                1 => line.angle,
-                _ => line.tension,
-            }
+        ContractVariable::Obstacle(slot, field) => {
+            field.of(&ObstacleSlot::EMPTY)?;
+            read(&|w| field.of(&w.obstacle(slot.index())).unwrap_or(f64::NAN))
         }
-        _ => {
-            let slot = ((vr - 1000) / 10) as usize;
-            let o = w.obstacle(slot);
-            match (vr - 1000) % 10 {
-                0 => o.x,
-                1 => o.y,
-                2 => o.psi,
-                3 => o.speed,
-                4 => o.length,
-                5 => o.width,
-                _ => f64::NAN,
-            }
-        }
+        _ => None,
     }
 }
 
