@@ -17,6 +17,8 @@
 //! MCAP log (docs/logging.md): with `log_file` set, the file is created when initialization
 //! ends and gets every topic at each control sample; terminate closes it (a failure is
 //! `fmi2Error`), and `fmi2FreeInstance` closes it if terminate did not.
+//! Loading the scenario and the log's life cycle are `towing-interface`'s [`RunSession`],
+//! which the plant uses too.
 //!
 //! FMU state: the solvers' warm starts and factorisations cannot be copied, so the FMU
 //! declares `canGetAndSetFMUstate="false"`. The layer still clones the model on
@@ -27,14 +29,12 @@ use crate::diagnostics::Outputs;
 use crate::logging::{self, Sample};
 use crate::variables::{self as vars, ControllerVariable as V, Tunables, REAL_PARAMETERS};
 use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome, ValueType};
-use std::path::{Path, PathBuf};
 use towing_control::{Architecture, AvoidanceScheme, Controller, ControllerConfig, Measurement};
 use towing_interface::codec::{
     obstacle_kind_code, obstacle_kind_from_code, ContractVariable, ObstacleField, TowlineField,
     Vessel,
 };
-use towing_interface::ScenarioFile;
-use towing_log::{LogOptions, RunInfo, SharedLog};
+use towing_interface::{LogHeader, RunSession};
 use towing_model::{HullModel, Scenario};
 
 /// Tolerance of the sample-instant test (ns): a communication point within 1 us before a
@@ -46,8 +46,6 @@ const STATE_MAGIC: &[u8; 4] = b"TWCT";
 /// Parameter values (FMI `parameter` variables).
 #[derive(Debug, Clone, PartialEq)]
 struct Parameters {
-    scenario: String,
-    log_file: String,
     hull_model: i32,
     architecture: i32,
     avoidance_scheme: i32,
@@ -62,8 +60,6 @@ impl Default for Parameters {
         let ints = vars::integer_parameter_defaults();
         let int = |vr: u32| ints.iter().find(|(v, _)| *v == vr).map_or(0, |(_, s)| *s);
         Self {
-            scenario: String::new(),
-            log_file: String::new(),
             hull_model: int(vars::HULL_MODEL),
             architecture: int(vars::ARCHITECTURE),
             avoidance_scheme: int(vars::AVOIDANCE_SCHEME),
@@ -232,20 +228,16 @@ pub struct ControllerFmu {
     params: Parameters,
     inputs: Inputs,
     outputs: Outputs,
-    resource_dir: Option<PathBuf>,
     /// Set once initialization mode was entered: a new `scenario` is then read at once.
     initializing: bool,
-    scenario: Option<Scenario>,
+    /// `scenario`, `log_file`, the scenario as loaded and the MCAP log (open from the end
+    /// of initialization while `log_file` is set; shared with copies).
+    session: RunSession,
     controller: Option<Controller>,
     clock: Clock,
     /// This value is a copy made by `fmi2GetFMUstate` of an initialized instance: it has
     /// no controller and refuses to step.
     copied_without_controller: bool,
-    /// The scenario text as loaded (for the log's attachment).
-    scenario_text: String,
-    /// The MCAP log, open from the end of initialization while `log_file` is set (shared
-    /// with copies).
-    log: SharedLog,
 }
 
 impl Clone for ControllerFmu {
@@ -256,14 +248,11 @@ impl Clone for ControllerFmu {
             params: self.params.clone(),
             inputs: self.inputs,
             outputs: self.outputs,
-            resource_dir: self.resource_dir.clone(),
             initializing: self.initializing,
-            scenario: self.scenario.clone(),
+            session: self.session.clone(),
             controller: None,
             clock: self.clock,
             copied_without_controller: self.controller.is_some() || self.copied_without_controller,
-            scenario_text: self.scenario_text.clone(),
-            log: self.log.clone(),
         }
     }
 }
@@ -271,30 +260,25 @@ impl Clone for ControllerFmu {
 impl ControllerFmu {
     /// Reads the scenario named by the `scenario` parameter (or the bundled one).
     fn load(&mut self, log: &Logger) -> Result<(), String> {
-        let ScenarioFile {
-            origin,
-            scenario,
-            text,
-        } = ScenarioFile::load(&self.params.scenario, self.resource_dir.as_deref())?;
-        log.info(
-            "logEvents",
-            &format!("scenario '{}' loaded from {origin}", scenario.name),
-        );
-        self.scenario = Some(scenario);
-        self.scenario_text = text;
-        Ok(())
+        self.session.load(|file| {
+            log.info(
+                "logEvents",
+                &format!(
+                    "scenario '{}' loaded from {}",
+                    file.scenario.name, file.origin
+                ),
+            );
+            Ok(())
+        })
     }
 
     /// Creates the log named by `log_file` (if any) and writes the run description.
     fn open_log(&mut self, log: &Logger) -> Result<(), String> {
-        if self.params.log_file.is_empty() {
-            return Ok(());
-        }
         let guid = vars::DESCRIPTION.guid();
         let p = &self.params;
         let mut parameters = serde_json::Map::new();
-        parameters.insert("scenario".into(), p.scenario.clone().into());
-        parameters.insert("log_file".into(), p.log_file.clone().into());
+        parameters.insert("scenario".into(), self.session.scenario_parameter().into());
+        parameters.insert("log_file".into(), self.session.log_file().into());
         for (name, value) in [
             ("hull_model", p.hull_model),
             ("architecture", p.architecture),
@@ -307,28 +291,14 @@ impl ControllerFmu {
         for (rp, &value) in REAL_PARAMETERS.iter().zip(&p.reals) {
             parameters.insert(rp.name.into(), value.into());
         }
-        let info = RunInfo {
+        let header = LogHeader {
             unit: vars::MODEL_IDENTIFIER,
             guid: &guid,
             version: env!("CARGO_PKG_VERSION"),
-            scenario: &p.scenario,
-            scenario_name: self.scenario.as_ref().map_or("", |s| s.name.as_str()),
             start_time: self.clock.start_time,
             parameters: serde_json::Value::Object(parameters),
-            scenario_text: &self.scenario_text,
         };
-        self.log = SharedLog::open(
-            &p.log_file,
-            LogOptions::default(),
-            &info,
-            logging::register_topics,
-        )
-        .map_err(|e| format!("parameter `log_file`: {e}"))?;
-        log.info(
-            "logEvents",
-            &format!("MCAP log {} created", self.params.log_file),
-        );
-        Ok(())
+        self.session.open_log(log, header, logging::register_topics)
     }
 }
 
@@ -342,14 +312,11 @@ impl Fmi2Model for ControllerFmu {
             params: Parameters::default(),
             inputs: Inputs::default(),
             outputs: Outputs::default(),
-            resource_dir: ctx.resource_dir.map(Path::to_path_buf),
             initializing: false,
-            scenario: None,
+            session: RunSession::new(ctx.resource_dir),
             controller: None,
             clock: Clock::default(),
             copied_without_controller: false,
-            scenario_text: String::new(),
-            log: SharedLog::none(),
         })
     }
 
@@ -372,8 +339,9 @@ impl Fmi2Model for ControllerFmu {
     fn exit_initialization_mode(&mut self, log: &Logger) -> Result<(), String> {
         self.initializing = false;
         let scenario = self
-            .scenario
-            .clone()
+            .session
+            .scenario()
+            .cloned()
             .ok_or_else(|| "no scenario is loaded".to_owned())?;
         let config = self.params.config(scenario)?;
         let sample_time = config.prediction.sample_time;
@@ -493,8 +461,10 @@ impl Fmi2Model for ControllerFmu {
 
     fn get_string(&self, vr: u32) -> Result<String, String> {
         match vars::VARIABLES.decode(ValueType::String, vr)? {
-            V::Contract(ContractVariable::Scenario) => Ok(self.params.scenario.clone()),
-            V::Contract(ContractVariable::LogFile) => Ok(self.params.log_file.clone()),
+            V::Contract(ContractVariable::Scenario) => {
+                Ok(self.session.scenario_parameter().to_owned())
+            }
+            V::Contract(ContractVariable::LogFile) => Ok(self.session.log_file().to_owned()),
             other => Err(vars::VARIABLES.unhandled(ValueType::String, other, "get")),
         }
     }
@@ -502,17 +472,17 @@ impl Fmi2Model for ControllerFmu {
     fn set_string(&mut self, log: &Logger, vr: u32, value: &str) -> Result<(), String> {
         match vars::VARIABLES.decode(ValueType::String, vr)? {
             V::Contract(ContractVariable::Scenario) => {
-                let previous = std::mem::replace(&mut self.params.scenario, value.to_owned());
+                let previous = self.session.replace_scenario_parameter(value);
                 if self.initializing {
                     if let Err(e) = self.load(log) {
-                        self.params.scenario = previous;
+                        self.session.replace_scenario_parameter(&previous);
                         return Err(e);
                     }
                 }
                 Ok(())
             }
             V::Contract(ContractVariable::LogFile) => {
-                value.clone_into(&mut self.params.log_file);
+                self.session.set_log_file(value);
                 Ok(())
             }
             _ => Err(format!("value reference {vr} is not a settable String")),
@@ -537,7 +507,7 @@ impl Fmi2Model for ControllerFmu {
         if now_ns + SAMPLE_TOLERANCE_NS >= self.clock.next_sample_ns {
             match controller.sample(&self.inputs.measurement) {
                 Ok(report) => {
-                    if self.log.is_active() {
+                    if self.session.log().is_active() {
                         sampled = Some(report);
                     }
                     self.outputs.record(&report);
@@ -589,7 +559,8 @@ impl Fmi2Model for ControllerFmu {
                 warning,
             };
             let failed = self
-                .log
+                .session
+                .log()
                 .batch(Box::new(move |w| logging::write_sample(w, &sample)));
             if let Some(failed) = failed {
                 outcome = match outcome {
@@ -602,16 +573,11 @@ impl Fmi2Model for ControllerFmu {
     }
 
     fn terminate(&mut self, _log: &Logger) -> Result<(), String> {
-        self.log
-            .finish()
-            .map(drop)
-            .map_err(|e| format!("closing the log: {e}"))
+        self.session.terminate()
     }
 
     fn release(&mut self, log: &Logger) {
-        if let Err(e) = self.log.finish() {
-            log.error(&format!("closing the log: {e}"));
-        }
+        self.session.release(log);
     }
 
     /// Writes only a marker: the state is not serialisable (`canSerializeFMUstate="false"`),

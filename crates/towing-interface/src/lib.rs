@@ -16,6 +16,9 @@
 //!   ([`ModelInfo`]).
 //! * [`scenario`]: the `scenario` String parameter (a file path, or the bundled
 //!   `resources/paper.toml`).
+//! * [`session`]: the scenario and log life cycle both FMUs share ([`RunSession`]): the
+//!   `scenario` and `log_file` parameters, the scenario as loaded, the MCAP log opened with
+//!   the run description and finished at terminate or release.
 //! * [`model_description_main`]: the body of each FMU's model description binary (`plant_model_description`, `controller_model_description`).
 //! * `testing` (feature `testing`): in-process test helpers shared by the FMU crates.
 //!
@@ -27,6 +30,7 @@
 
 pub mod codec;
 pub mod scenario;
+pub mod session;
 pub mod types;
 pub mod variables;
 pub mod vr;
@@ -41,6 +45,7 @@ use std::process::ExitCode;
 
 pub use codec::{ContractVariable, ModelVariable, UnknownReference, VariableTable};
 pub use scenario::{ScenarioFile, BUNDLED_SCENARIO};
+pub use session::{LogHeader, RunSession};
 pub use types::{ModelInfo, RealType};
 pub use variables::Direction;
 
