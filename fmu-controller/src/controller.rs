@@ -17,23 +17,25 @@
 //! MCAP log (docs/logging.md): with `log_file` set, the file is created when initialization
 //! ends and gets every topic at each control sample; terminate closes it (a failure is
 //! `fmi2Error`), and `fmi2FreeInstance` closes it if terminate did not.
+//! Loading the scenario and the log's life cycle are `towing-interface`'s [`RunSession`],
+//! which the plant uses too.
 //!
 //! FMU state: the solvers' warm starts and factorisations cannot be copied, so the FMU
 //! declares `canGetAndSetFMUstate="false"`. The layer still clones the model on
 //! `fmi2GetFMUstate`; a clone carries no controller, and an instance restored from one
 //! refuses to step with a message saying why (never a silent cold start).
 
+use crate::diagnostics::Outputs;
 use crate::logging::{self, Sample};
-use crate::variables::{self as vars, Tunables, NO_OBSTACLE_DISTANCE, REAL_PARAMETERS};
-use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome};
-use std::path::{Path, PathBuf};
-use towing_control::{
-    Architecture, AvoidanceScheme, Command, Controller, ControllerConfig, Measurement, SampleReport,
+use crate::variables::{self as vars, ControllerVariable as V, Tunables, REAL_PARAMETERS};
+use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome, ValueType};
+use towing_control::{Architecture, AvoidanceScheme, Controller, ControllerConfig, Measurement};
+use towing_interface::codec::{
+    obstacle_kind_code, obstacle_kind_from_code, ContractVariable, ObstacleField, TowlineField,
+    Vessel,
 };
-use towing_interface::ScenarioFile;
-use towing_log::{LogOptions, RunInfo, SharedLog};
-use towing_model::{HullModel, Scenario, MAX_OBSTACLES};
-use towing_mpc::HORIZON;
+use towing_interface::{LogHeader, RunSession};
+use towing_model::{HullModel, Scenario};
 
 /// Tolerance of the sample-instant test (ns): a communication point within 1 us before a
 /// sample instant samples.
@@ -44,8 +46,6 @@ const STATE_MAGIC: &[u8; 4] = b"TWCT";
 /// Parameter values (FMI `parameter` variables).
 #[derive(Debug, Clone, PartialEq)]
 struct Parameters {
-    scenario: String,
-    log_file: String,
     hull_model: i32,
     architecture: i32,
     avoidance_scheme: i32,
@@ -60,8 +60,6 @@ impl Default for Parameters {
         let ints = vars::integer_parameter_defaults();
         let int = |vr: u32| ints.iter().find(|(v, _)| *v == vr).map_or(0, |(_, s)| *s);
         Self {
-            scenario: String::new(),
-            log_file: String::new(),
             hull_model: int(vars::HULL_MODEL),
             architecture: int(vars::ARCHITECTURE),
             avoidance_scheme: int(vars::AVOIDANCE_SCHEME),
@@ -156,134 +154,61 @@ struct Inputs {
 }
 
 impl Inputs {
-    fn real_mut(&mut self, vr: u32) -> Option<&mut f64> {
+    /// The vessel state array of `vessel`: `[x, y, psi, u, v, r]`.
+    fn vessel_mut(&mut self, vessel: Vessel) -> &mut [f64; 6] {
         let m = &mut self.measurement;
-        match vr {
-            100..=105 => Some(&mut m.ship[(vr - 100) as usize]),
-            110..=115 => Some(&mut m.tugs[0][(vr - 110) as usize]),
-            120..=125 => Some(&mut m.tugs[1][(vr - 120) as usize]),
-            300..=302 => Some(&mut self.towlines[0][(vr - 300) as usize]),
-            310..=312 => Some(&mut self.towlines[1][(vr - 310) as usize]),
-            1000..=1079 => {
-                let slot = ((vr - 1000) / 10) as usize;
-                let o = &mut m.obstacles[slot];
-                match (vr - 1000) % 10 {
-                    0 => Some(&mut o.x),
-                    1 => Some(&mut o.y),
-                    2 => Some(&mut o.psi),
-                    3 => Some(&mut o.speed),
-                    4 => Some(&mut o.length),
-                    5 => Some(&mut o.width),
-                    _ => None,
+        match vessel {
+            Vessel::Ship => &mut m.ship,
+            Vessel::Tug1 => &mut m.tugs[0],
+            Vessel::Tug2 => &mut m.tugs[1],
+        }
+    }
+
+    /// The Real input `c`, to write; `None` when `c` is not a Real input.
+    fn real_mut(&mut self, c: ContractVariable) -> Option<&mut f64> {
+        match c {
+            ContractVariable::VesselState(vessel, component) => {
+                Some(&mut self.vessel_mut(vessel)[component.index()])
+            }
+            ContractVariable::Towline(line, field) => {
+                let [length, angle, tension] = &mut self.towlines[line.index()];
+                match field {
+                    TowlineField::Length => Some(length),
+                    TowlineField::Angle => Some(angle),
+                    TowlineField::Tension => Some(tension),
+                    TowlineField::Slack => None,
                 }
+            }
+            ContractVariable::Obstacle(slot, field) => {
+                field.of_mut(&mut self.measurement.obstacles[slot.index()])
             }
             _ => None,
         }
     }
 
-    fn real(&self, vr: u32) -> Option<f64> {
+    /// The Real input `c`; `None` when `c` is not a Real input.
+    fn real(&self, c: ContractVariable) -> Option<f64> {
         let m = &self.measurement;
-        match vr {
-            100..=105 => Some(m.ship[(vr - 100) as usize]),
-            110..=115 => Some(m.tugs[0][(vr - 110) as usize]),
-            120..=125 => Some(m.tugs[1][(vr - 120) as usize]),
-            300..=302 => Some(self.towlines[0][(vr - 300) as usize]),
-            310..=312 => Some(self.towlines[1][(vr - 310) as usize]),
-            1000..=1079 => {
-                let o = &m.obstacles[((vr - 1000) / 10) as usize];
-                match (vr - 1000) % 10 {
-                    0 => Some(o.x),
-                    1 => Some(o.y),
-                    2 => Some(o.psi),
-                    3 => Some(o.speed),
-                    4 => Some(o.length),
-                    5 => Some(o.width),
-                    _ => None,
+        match c {
+            ContractVariable::VesselState(vessel, component) => {
+                let state = match vessel {
+                    Vessel::Ship => &m.ship,
+                    Vessel::Tug1 => &m.tugs[0],
+                    Vessel::Tug2 => &m.tugs[1],
+                };
+                Some(state[component.index()])
+            }
+            ContractVariable::Towline(line, field) => {
+                let [length, angle, tension] = self.towlines[line.index()];
+                match field {
+                    TowlineField::Length => Some(length),
+                    TowlineField::Angle => Some(angle),
+                    TowlineField::Tension => Some(tension),
+                    TowlineField::Slack => None,
                 }
             }
+            ContractVariable::Obstacle(slot, field) => field.of(&m.obstacles[slot.index()]),
             _ => None,
-        }
-    }
-}
-
-/// The outputs: commands and diagnostics, holding their start values until the first step.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Outputs {
-    command: Command,
-    iterations: i32,
-    converged: bool,
-    r_pri: [f64; 2],
-    r_dual: [f64; 2],
-    compute_time: f64,
-    fallbacks: i32,
-    samples: i32,
-    reference: [f64; 3],
-    active_waypoint: i32,
-    altered: bool,
-    d_ob: f64,
-    angle_desired: [f64; 2],
-    situation: [i32; MAX_OBSTACLES],
-    role: [i32; MAX_OBSTACLES],
-    /// `[h][vessel][axis]`.
-    prediction: [[[f64; 2]; 3]; HORIZON],
-}
-
-impl Default for Outputs {
-    fn default() -> Self {
-        Self {
-            command: Command::default(),
-            iterations: 0,
-            converged: false,
-            r_pri: [0.0; 2],
-            r_dual: [0.0; 2],
-            compute_time: 0.0,
-            fallbacks: 0,
-            samples: 0,
-            reference: [0.0; 3],
-            active_waypoint: 0,
-            altered: false,
-            d_ob: NO_OBSTACLE_DISTANCE,
-            angle_desired: [0.0; 2],
-            situation: [-1; MAX_OBSTACLES],
-            role: [0; MAX_OBSTACLES],
-            prediction: [[[0.0; 2]; 3]; HORIZON],
-        }
-    }
-}
-
-fn saturating_i32<T: TryInto<i32>>(x: T) -> i32 {
-    x.try_into().unwrap_or(i32::MAX)
-}
-
-impl Outputs {
-    fn record(&mut self, r: &SampleReport) {
-        self.iterations = saturating_i32(r.iterations);
-        self.converged = r.converged;
-        self.r_pri = r.r_pri;
-        self.r_dual = r.r_dual;
-        self.compute_time = r.compute_time;
-        self.fallbacks = saturating_i32(r.fallbacks);
-        self.samples = self.samples.saturating_add(1);
-        self.reference = r.reference;
-        self.active_waypoint = saturating_i32(r.guidance.active_waypoint);
-        self.altered = r.guidance.altered;
-        self.d_ob = if r.guidance.d_ob.is_finite() {
-            r.guidance.d_ob.min(NO_OBSTACLE_DISTANCE)
-        } else {
-            NO_OBSTACLE_DISTANCE
-        };
-        self.angle_desired = r.desired_angle;
-        self.situation = r.situation;
-        self.role = r.role;
-        for h in 0..HORIZON {
-            let states = [
-                &r.prediction.ship[h],
-                &r.prediction.tugs[0][h],
-                &r.prediction.tugs[1][h],
-            ];
-            for (vessel, s) in states.iter().enumerate() {
-                self.prediction[h][vessel] = [s[0], s[1]];
-            }
         }
     }
 }
@@ -303,20 +228,16 @@ pub struct ControllerFmu {
     params: Parameters,
     inputs: Inputs,
     outputs: Outputs,
-    resource_dir: Option<PathBuf>,
     /// Set once initialization mode was entered: a new `scenario` is then read at once.
     initializing: bool,
-    scenario: Option<Scenario>,
+    /// `scenario`, `log_file`, the scenario as loaded and the MCAP log (open from the end
+    /// of initialization while `log_file` is set; shared with copies).
+    session: RunSession,
     controller: Option<Controller>,
     clock: Clock,
     /// This value is a copy made by `fmi2GetFMUstate` of an initialized instance: it has
     /// no controller and refuses to step.
     copied_without_controller: bool,
-    /// The scenario text as loaded (for the log's attachment).
-    scenario_text: String,
-    /// The MCAP log, open from the end of initialization while `log_file` is set (shared
-    /// with copies).
-    log: SharedLog,
 }
 
 impl Clone for ControllerFmu {
@@ -327,14 +248,11 @@ impl Clone for ControllerFmu {
             params: self.params.clone(),
             inputs: self.inputs,
             outputs: self.outputs,
-            resource_dir: self.resource_dir.clone(),
             initializing: self.initializing,
-            scenario: self.scenario.clone(),
+            session: self.session.clone(),
             controller: None,
             clock: self.clock,
             copied_without_controller: self.controller.is_some() || self.copied_without_controller,
-            scenario_text: self.scenario_text.clone(),
-            log: self.log.clone(),
         }
     }
 }
@@ -342,30 +260,25 @@ impl Clone for ControllerFmu {
 impl ControllerFmu {
     /// Reads the scenario named by the `scenario` parameter (or the bundled one).
     fn load(&mut self, log: &Logger) -> Result<(), String> {
-        let ScenarioFile {
-            origin,
-            scenario,
-            text,
-        } = ScenarioFile::load(&self.params.scenario, self.resource_dir.as_deref())?;
-        log.info(
-            "logEvents",
-            &format!("scenario '{}' loaded from {origin}", scenario.name),
-        );
-        self.scenario = Some(scenario);
-        self.scenario_text = text;
-        Ok(())
+        self.session.load(|file| {
+            log.info(
+                "logEvents",
+                &format!(
+                    "scenario '{}' loaded from {}",
+                    file.scenario.name, file.origin
+                ),
+            );
+            Ok(())
+        })
     }
 
     /// Creates the log named by `log_file` (if any) and writes the run description.
     fn open_log(&mut self, log: &Logger) -> Result<(), String> {
-        if self.params.log_file.is_empty() {
-            return Ok(());
-        }
         let guid = vars::DESCRIPTION.guid();
         let p = &self.params;
         let mut parameters = serde_json::Map::new();
-        parameters.insert("scenario".into(), p.scenario.clone().into());
-        parameters.insert("log_file".into(), p.log_file.clone().into());
+        parameters.insert("scenario".into(), self.session.scenario_parameter().into());
+        parameters.insert("log_file".into(), self.session.log_file().into());
         for (name, value) in [
             ("hull_model", p.hull_model),
             ("architecture", p.architecture),
@@ -378,53 +291,14 @@ impl ControllerFmu {
         for (rp, &value) in REAL_PARAMETERS.iter().zip(&p.reals) {
             parameters.insert(rp.name.into(), value.into());
         }
-        let info = RunInfo {
+        let header = LogHeader {
             unit: vars::MODEL_IDENTIFIER,
             guid: &guid,
             version: env!("CARGO_PKG_VERSION"),
-            scenario: &p.scenario,
-            scenario_name: self.scenario.as_ref().map_or("", |s| s.name.as_str()),
             start_time: self.clock.start_time,
             parameters: serde_json::Value::Object(parameters),
-            scenario_text: &self.scenario_text,
         };
-        self.log = SharedLog::open(
-            &p.log_file,
-            LogOptions::default(),
-            &info,
-            logging::register_topics,
-        )
-        .map_err(|e| format!("parameter `log_file`: {e}"))?;
-        log.info(
-            "logEvents",
-            &format!("MCAP log {} created", self.params.log_file),
-        );
-        Ok(())
-    }
-
-    fn real_parameter(&self, vr: u32) -> Option<f64> {
-        vars::real_parameter_index(vr).map(|i| self.params.reals[i])
-    }
-
-    fn output_real(&self, vr: u32) -> Option<f64> {
-        let o = &self.outputs;
-        Some(match vr {
-            200..=202 => o.command.tug_thrust[0][(vr - 200) as usize],
-            210..=212 => o.command.tug_thrust[1][(vr - 210) as usize],
-            220 | 221 => o.command.tension[(vr - 220) as usize],
-            3002 | 3003 => o.r_pri[(vr - 3002) as usize],
-            3004 | 3005 => o.r_dual[(vr - 3004) as usize],
-            vars::COMPUTE_TIME => o.compute_time,
-            3020..=3022 => o.reference[(vr - 3020) as usize],
-            vars::D_OB => o.d_ob,
-            3040 | 3041 => o.angle_desired[(vr - 3040) as usize],
-            3200..=3299 => {
-                let h = ((vr - 3200) / 10) as usize;
-                let j = ((vr - 3200) % 10) as usize;
-                *o.prediction.get(h)?.get(j / 2)?.get(j % 2)?
-            }
-            _ => return None,
-        })
+        self.session.open_log(log, header, logging::register_topics)
     }
 }
 
@@ -438,14 +312,11 @@ impl Fmi2Model for ControllerFmu {
             params: Parameters::default(),
             inputs: Inputs::default(),
             outputs: Outputs::default(),
-            resource_dir: ctx.resource_dir.map(Path::to_path_buf),
             initializing: false,
-            scenario: None,
+            session: RunSession::new(ctx.resource_dir),
             controller: None,
             clock: Clock::default(),
             copied_without_controller: false,
-            scenario_text: String::new(),
-            log: SharedLog::none(),
         })
     }
 
@@ -468,8 +339,9 @@ impl Fmi2Model for ControllerFmu {
     fn exit_initialization_mode(&mut self, log: &Logger) -> Result<(), String> {
         self.initializing = false;
         let scenario = self
-            .scenario
-            .clone()
+            .session
+            .scenario()
+            .cloned()
             .ok_or_else(|| "no scenario is loaded".to_owned())?;
         let config = self.params.config(scenario)?;
         let sample_time = config.prediction.sample_time;
@@ -500,27 +372,36 @@ impl Fmi2Model for ControllerFmu {
         self.open_log(log)
     }
 
-    fn get_real(&self, vr: u32) -> f64 {
-        self.real_parameter(vr)
-            .or_else(|| self.inputs.real(vr))
-            .or_else(|| self.output_real(vr))
-            .unwrap_or(f64::NAN)
+    fn get_real(&self, vr: u32) -> Result<f64, String> {
+        use ContractVariable as C;
+        let o = &self.outputs;
+        let variable = vars::VARIABLES.decode(ValueType::Real, vr)?;
+        let value = match variable {
+            V::RealParameter(i) => self.params.reals.get(i).copied(),
+            V::Diagnostic(d) => d.get().real_in(o),
+            V::Contract(C::TugForce(tug, c)) => Some(o.command.tug_thrust[tug.index()][c.index()]),
+            V::Contract(C::TensionCmd(line)) => Some(o.command.tension[line.index()]),
+            V::Contract(c) => self.inputs.real(c),
+            _ => None,
+        };
+        value.ok_or_else(|| vars::VARIABLES.unhandled(ValueType::Real, variable, "get"))
     }
 
     fn set_real(&mut self, _log: &Logger, vr: u32, value: f64) -> Result<(), String> {
         let name = || {
             vars::DESCRIPTION
-                .find(fmi2_slave::ValueType::Real, vr)
+                .find(ValueType::Real, vr)
                 .map_or_else(|| format!("vr {vr}"), |v| v.name.clone())
         };
         if !value.is_finite() {
             return Err(format!("input `{}` is not finite ({value})", name()));
         }
-        if let Some(i) = vars::real_parameter_index(vr) {
-            self.params.reals[i] = value;
-            return Ok(());
-        }
-        match self.inputs.real_mut(vr) {
+        let target = match vars::VARIABLES.decode(ValueType::Real, vr)? {
+            V::RealParameter(i) => self.params.reals.get_mut(i),
+            V::Contract(c) => self.inputs.real_mut(c),
+            _ => None,
+        };
+        match target {
             Some(x) => {
                 *x = value;
                 Ok(())
@@ -529,79 +410,79 @@ impl Fmi2Model for ControllerFmu {
         }
     }
 
-    fn get_integer(&self, vr: u32) -> i32 {
-        let o = &self.outputs;
-        match vr {
-            vars::HULL_MODEL => self.params.hull_model,
-            vars::ARCHITECTURE => self.params.architecture,
-            vars::AVOIDANCE_SCHEME => self.params.avoidance_scheme,
-            vars::MAX_ITERATIONS => self.params.max_iterations,
-            vars::PREDICTION_HORIZON => self.params.prediction_horizon,
-            vars::ADMM_ITERATIONS => o.iterations,
-            vars::FALLBACKS => o.fallbacks,
-            vars::SAMPLES => o.samples,
-            vars::ACTIVE_WAYPOINT => o.active_waypoint,
-            1000..=1079 => self.inputs.measurement.obstacles[((vr - 1000) / 10) as usize].kind,
-            3100..=3179 => {
-                let slot = ((vr - 3100) / 10) as usize;
-                match (vr - 3100) % 10 {
-                    0 => o.situation[slot],
-                    _ => o.role[slot],
-                }
-            }
-            _ => 0,
-        }
+    fn get_integer(&self, vr: u32) -> Result<i32, String> {
+        let p = &self.params;
+        let variable = vars::VARIABLES.decode(ValueType::Integer, vr)?;
+        let value = match variable {
+            V::HullModel => Some(p.hull_model),
+            V::Architecture => Some(p.architecture),
+            V::AvoidanceScheme => Some(p.avoidance_scheme),
+            V::MaxIterations => Some(p.max_iterations),
+            V::PredictionHorizon => Some(p.prediction_horizon),
+            V::Diagnostic(d) => d.get().integer_in(&self.outputs),
+            V::Contract(ContractVariable::Obstacle(slot, ObstacleField::Kind)) => Some(
+                obstacle_kind_code(self.inputs.measurement.obstacles[slot.index()].kind),
+            ),
+            _ => None,
+        };
+        value.ok_or_else(|| vars::VARIABLES.unhandled(ValueType::Integer, variable, "get"))
     }
 
     fn set_integer(&mut self, _log: &Logger, vr: u32, value: i32) -> Result<(), String> {
-        match vr {
-            vars::HULL_MODEL => self.params.hull_model = value,
-            vars::ARCHITECTURE => self.params.architecture = value,
-            vars::AVOIDANCE_SCHEME => self.params.avoidance_scheme = value,
-            vars::MAX_ITERATIONS => self.params.max_iterations = value,
-            vars::PREDICTION_HORIZON => self.params.prediction_horizon = value,
-            1000..=1079 if (vr - 1000) % 10 == vars::OBSTACLE_KIND => {
-                self.inputs.measurement.obstacles[((vr - 1000) / 10) as usize].kind = value;
+        let p = &mut self.params;
+        match vars::VARIABLES.decode(ValueType::Integer, vr)? {
+            V::HullModel => p.hull_model = value,
+            V::Architecture => p.architecture = value,
+            V::AvoidanceScheme => p.avoidance_scheme = value,
+            V::MaxIterations => p.max_iterations = value,
+            V::PredictionHorizon => p.prediction_horizon = value,
+            V::Contract(ContractVariable::Obstacle(slot, ObstacleField::Kind)) => {
+                self.inputs.measurement.obstacles[slot.index()].kind =
+                    obstacle_kind_from_code(value)?;
             }
             _ => return Err(format!("value reference {vr} is not a settable Integer")),
         }
         Ok(())
     }
 
-    fn get_boolean(&self, vr: u32) -> bool {
-        match vr {
-            vars::ADMM_CONVERGED => self.outputs.converged,
-            vars::ALTERED => self.outputs.altered,
-            _ => false,
-        }
+    fn get_boolean(&self, vr: u32) -> Result<bool, String> {
+        let variable = vars::VARIABLES.decode(ValueType::Boolean, vr)?;
+        let value = match variable {
+            V::Diagnostic(d) => d.get().boolean_in(&self.outputs),
+            _ => None,
+        };
+        value.ok_or_else(|| vars::VARIABLES.unhandled(ValueType::Boolean, variable, "get"))
     }
 
     fn set_boolean(&mut self, _log: &Logger, vr: u32, _value: bool) -> Result<(), String> {
+        vars::VARIABLES.decode(ValueType::Boolean, vr)?;
         Err(format!("value reference {vr} is not a settable Boolean"))
     }
 
-    fn get_string(&self, vr: u32) -> String {
-        match vr {
-            vars::SCENARIO => self.params.scenario.clone(),
-            vars::LOG_FILE => self.params.log_file.clone(),
-            _ => String::new(),
+    fn get_string(&self, vr: u32) -> Result<String, String> {
+        match vars::VARIABLES.decode(ValueType::String, vr)? {
+            V::Contract(ContractVariable::Scenario) => {
+                Ok(self.session.scenario_parameter().to_owned())
+            }
+            V::Contract(ContractVariable::LogFile) => Ok(self.session.log_file().to_owned()),
+            other => Err(vars::VARIABLES.unhandled(ValueType::String, other, "get")),
         }
     }
 
     fn set_string(&mut self, log: &Logger, vr: u32, value: &str) -> Result<(), String> {
-        match vr {
-            vars::SCENARIO => {
-                let previous = std::mem::replace(&mut self.params.scenario, value.to_owned());
+        match vars::VARIABLES.decode(ValueType::String, vr)? {
+            V::Contract(ContractVariable::Scenario) => {
+                let previous = self.session.replace_scenario_parameter(value);
                 if self.initializing {
                     if let Err(e) = self.load(log) {
-                        self.params.scenario = previous;
+                        self.session.replace_scenario_parameter(&previous);
                         return Err(e);
                     }
                 }
                 Ok(())
             }
-            vars::LOG_FILE => {
-                value.clone_into(&mut self.params.log_file);
+            V::Contract(ContractVariable::LogFile) => {
+                self.session.set_log_file(value);
                 Ok(())
             }
             _ => Err(format!("value reference {vr} is not a settable String")),
@@ -626,7 +507,7 @@ impl Fmi2Model for ControllerFmu {
         if now_ns + SAMPLE_TOLERANCE_NS >= self.clock.next_sample_ns {
             match controller.sample(&self.inputs.measurement) {
                 Ok(report) => {
-                    if self.log.is_active() {
+                    if self.session.log().is_active() {
                         sampled = Some(report);
                     }
                     self.outputs.record(&report);
@@ -678,7 +559,8 @@ impl Fmi2Model for ControllerFmu {
                 warning,
             };
             let failed = self
-                .log
+                .session
+                .log()
                 .batch(Box::new(move |w| logging::write_sample(w, &sample)));
             if let Some(failed) = failed {
                 outcome = match outcome {
@@ -691,16 +573,11 @@ impl Fmi2Model for ControllerFmu {
     }
 
     fn terminate(&mut self, _log: &Logger) -> Result<(), String> {
-        self.log
-            .finish()
-            .map(drop)
-            .map_err(|e| format!("closing the log: {e}"))
+        self.session.terminate()
     }
 
     fn release(&mut self, log: &Logger) {
-        if let Err(e) = self.log.finish() {
-            log.error(&format!("closing the log: {e}"));
-        }
+        self.session.release(log);
     }
 
     /// Writes only a marker: the state is not serialisable (`canSerializeFMUstate="false"`),

@@ -4,14 +4,13 @@
 //! compresses them.
 
 use towing_control::{Measurement, SampleReport};
-use towing_guidance::Pose;
 use towing_log::scene::{self, colors};
 use towing_log::topics::{
     names, role_name, situation_name, Colregs, Command, Encounter, Log, Prediction, Reference,
     SceneEntity, SceneUpdate, Solver, CONTROLLER_TOPICS,
 };
 use towing_log::{LogError, LogWriter};
-use towing_model::MAX_OBSTACLES;
+use towing_model::{ObstacleKind, Pose, MAX_OBSTACLES};
 
 /// Diameter of the active-waypoint sphere (m).
 const WAYPOINT_DIAMETER: f64 = 0.35;
@@ -86,7 +85,7 @@ pub fn write_sample(w: &mut LogWriter, s: &Sample) -> Result<(), LogError> {
         },
     )?;
     let targets = (0..MAX_OBSTACLES)
-        .filter(|&k| s.measurement.obstacles[k].kind != 0)
+        .filter(|&k| s.measurement.obstacles[k].kind != ObstacleKind::None)
         .map(|k| Encounter {
             slot: k as u32 + 1,
             situation: situation_name(r.situation[k]).to_owned(),

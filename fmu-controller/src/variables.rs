@@ -15,19 +15,22 @@
 //! | 1..=9 | String and Integer parameters ([`SCENARIO`] .. [`PREDICTION_HORIZON`]) |
 //! | 10..=99 | Real parameters ([`REAL_PARAMETERS`], `10 + index`) |
 //! | 100..=1079 | the connected variables of `towing-interface` (vessel states, commands, towlines, obstacle slots) |
-//! | 3000..=3041 | diagnostics: ADMM, timing, reference, guidance, desired angles |
-//! | 3100 + 10 (k - 1) + j | COLREGS situation (j = 0) and role (j = 1) of obstacle slot k |
-//! | 3200 + 10 (h - 1) + j | predicted positions after sample h = 1..=3 (j: ship x, y, tug1 x, y, tug2 x, y) |
+//! | 3000.. | diagnostics ([`crate::diagnostics`]) |
+//!
+//! The controller's getters and setters decode every value reference through
+//! [`VARIABLES`] into a [`ControllerVariable`] and match on it.
 
-use fmi2_slave::description::{ModelDescription, Variable, VariableKind};
+use crate::diagnostics::{self, DIAGNOSTICS};
+use fmi2_slave::description::{ModelDescription, VariableKind};
+use fmi2_slave::ValueType;
 use std::sync::LazyLock;
 use towing_control::{ControllerConfig, InnerLoopParams, TrackingParams};
 use towing_guidance::GuidanceSettings;
-use towing_interface::variables::{
-    self as shared, calculated_output, exact_output, parameter, Direction,
+use towing_interface::codec::{
+    ContractVariable, ModelVariable, Towline, TowlineField, VariableTable,
 };
-use towing_interface::{ModelInfo, RealType, VESSELS};
-use towing_model::MAX_OBSTACLES;
+use towing_interface::variables::{self as shared, calculated_output, parameter, Direction};
+use towing_interface::{ModelInfo, RealType};
 use towing_mpc::{
     AdmmSettings, CentralizedSettings, PredictionParams, ShipMpcParams, TugMpcParams, HORIZON,
 };
@@ -50,55 +53,97 @@ pub const MAX_ITERATIONS: u32 = 6;
 /// `prediction_horizon` (H_P of Table 3; compiled in as [`HORIZON`]).
 pub const PREDICTION_HORIZON: u32 = 7;
 
-/// `admm.iterations` (Integer output).
-pub const ADMM_ITERATIONS: u32 = 3000;
-/// `admm.converged` (Boolean output).
-pub const ADMM_CONVERGED: u32 = 3001;
-/// `admm.primal_residual1/2` (Real outputs), tug 0 or 1.
-pub const fn primal_residual(tug: u32) -> u32 {
-    3002 + tug
-}
-/// `admm.dual_residual1/2` (Real outputs), tug 0 or 1.
-pub const fn dual_residual(tug: u32) -> u32 {
-    3004 + tug
-}
-/// `controller.compute_time` (Real output, s).
-pub const COMPUTE_TIME: u32 = 3010;
-/// `controller.fallbacks` (Integer output).
-pub const FALLBACKS: u32 = 3011;
-/// `controller.samples` (Integer output).
-pub const SAMPLES: u32 = 3012;
-/// `reference.x`, `.y`, `.psi` (Real outputs), component 0..3.
-pub const fn reference(component: u32) -> u32 {
-    3020 + component
-}
-/// `guidance.active_waypoint` (Integer output).
-pub const ACTIVE_WAYPOINT: u32 = 3030;
-/// `guidance.altered` (Boolean output).
-pub const ALTERED: u32 = 3031;
-/// `guidance.d_ob` (Real output, m).
-pub const D_OB: u32 = 3032;
-/// `towline1/2.angle_desired` (Real outputs, rad), line 0 or 1.
-pub const fn angle_desired(line: u32) -> u32 {
-    3040 + line
-}
-/// `colregs[k].situation` (Integer output), `slot` 0-based.
-pub const fn colregs_situation(slot: u32) -> u32 {
-    3100 + 10 * slot
-}
-/// `colregs[k].role` (Integer output), `slot` 0-based.
-pub const fn colregs_role(slot: u32) -> u32 {
-    3101 + 10 * slot
-}
-/// `prediction.<vessel>[h].x/.y` (Real outputs): `step` 0-based (h - 1), vessel 0 ship,
-/// 1 tug1, 2 tug2; axis 0 x, 1 y.
-pub const fn prediction(step: u32, vessel: u32, axis: u32) -> u32 {
-    3200 + 10 * step + 2 * vessel + axis
+pub use crate::diagnostics::{
+    angle_desired, colregs_role, colregs_situation, dual_residual, prediction, primal_residual,
+    reference, ACTIVE_WAYPOINT, ADMM_CONVERGED, ADMM_ITERATIONS, ALTERED, COMPUTE_TIME, D_OB,
+    FALLBACKS, NO_OBSTACLE_DISTANCE, SAMPLES,
+};
+
+/// A diagnostic output: its index in [`DIAGNOSTICS`] (only [`VARIABLES`] makes them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DiagnosticId(usize);
+
+impl DiagnosticId {
+    /// The diagnostic.
+    #[must_use]
+    pub fn get(self) -> &'static diagnostics::Diagnostic {
+        &DIAGNOSTICS[self.0]
+    }
 }
 
-/// `guidance.d_ob` when no obstacle is active (m): a large finite number, since FMI Real
-/// outputs must be finite.
-pub const NO_OBSTACLE_DISTANCE: f64 = 1e6;
+/// A variable of the controller, as its getters and setters see it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ControllerVariable {
+    /// A variable of the interface contract: the controller declares every one but the
+    /// plant's `towlineN.slack` (the measurements as inputs, the commands as outputs).
+    Contract(ContractVariable),
+    /// `hull_model` (Integer parameter).
+    HullModel,
+    /// `architecture` (Integer parameter).
+    Architecture,
+    /// `avoidance_scheme` (Integer parameter).
+    AvoidanceScheme,
+    /// `max_iterations` (Integer parameter).
+    MaxIterations,
+    /// `prediction_horizon` (Integer parameter).
+    PredictionHorizon,
+    /// A Real parameter: its index in [`REAL_PARAMETERS`].
+    RealParameter(usize),
+    /// A diagnostic output.
+    Diagnostic(DiagnosticId),
+}
+
+impl ModelVariable for ControllerVariable {
+    fn value_reference(self) -> u32 {
+        match self {
+            ControllerVariable::Contract(c) => c.encode(),
+            ControllerVariable::HullModel => HULL_MODEL,
+            ControllerVariable::Architecture => ARCHITECTURE,
+            ControllerVariable::AvoidanceScheme => AVOIDANCE_SCHEME,
+            ControllerVariable::MaxIterations => MAX_ITERATIONS,
+            ControllerVariable::PredictionHorizon => PREDICTION_HORIZON,
+            ControllerVariable::RealParameter(i) => real_parameter_vr(i),
+            ControllerVariable::Diagnostic(d) => d.get().value_reference,
+        }
+    }
+
+    fn value_type(self) -> ValueType {
+        match self {
+            ControllerVariable::Contract(c) => c.value_type(),
+            ControllerVariable::RealParameter(_) => ValueType::Real,
+            ControllerVariable::Diagnostic(d) => d.get().value_type(),
+            _ => ValueType::Integer,
+        }
+    }
+
+    fn contract(self) -> Option<ContractVariable> {
+        match self {
+            ControllerVariable::Contract(c) => Some(c),
+            _ => None,
+        }
+    }
+}
+
+/// The controller's variables by value reference, built once.
+pub static VARIABLES: LazyLock<VariableTable<ControllerVariable>> = LazyLock::new(|| {
+    use ControllerVariable as V;
+    let contract = ContractVariable::all()
+        .filter(|c| !matches!(c, ContractVariable::Towline(_, TowlineField::Slack)))
+        .map(V::Contract);
+    let integers = [
+        V::HullModel,
+        V::Architecture,
+        V::AvoidanceScheme,
+        V::MaxIterations,
+        V::PredictionHorizon,
+    ];
+    let reals = (0..REAL_PARAMETERS.len()).map(V::RealParameter);
+    let outputs = (0..DIAGNOSTICS.len()).map(|i| V::Diagnostic(DiagnosticId(i)));
+    VariableTable::new(
+        MODEL_IDENTIFIER,
+        contract.chain(integers).chain(reals).chain(outputs),
+    )
+});
 
 /// The controller's model-description header: the Real types of the interface, plus those
 /// of the rate and bandwidth parameters.
@@ -194,13 +239,6 @@ pub struct RealParameter {
 /// Value reference of the Real parameter at `index` of [`REAL_PARAMETERS`].
 pub const fn real_parameter_vr(index: usize) -> u32 {
     10 + index as u32
-}
-
-/// Index of a Real parameter by value reference.
-#[must_use]
-pub fn real_parameter_index(vr: u32) -> Option<usize> {
-    let i = vr.checked_sub(10)? as usize;
-    (i < REAL_PARAMETERS.len()).then_some(i)
 }
 
 /// The Real parameters, in value-reference order (`10 + index`).
@@ -601,10 +639,6 @@ fn real_kind(unit: &str, start: Option<f64>) -> VariableKind {
     INFO.real_kind(unit, start)
 }
 
-fn real_out(name: String, vr: u32, unit: &str, start: f64, description: String) -> Variable {
-    exact_output(name, vr, real_kind(unit, Some(start)), description)
-}
-
 fn int_kind(start: i32, min: i32, max: i32) -> VariableKind {
     VariableKind::Integer {
         declared_type: None,
@@ -614,7 +648,6 @@ fn int_kind(start: i32, min: i32, max: i32) -> VariableKind {
     }
 }
 
-#[allow(clippy::too_many_lines)]
 fn build() -> ModelDescription {
     let defaults = Tunables::default();
     let int_defaults = integer_parameter_defaults();
@@ -680,7 +713,7 @@ fn build() -> ModelDescription {
 
     // Inputs: the plant's outputs; outputs: the plant's inputs.
     v.extend(shared::vessel_states(Direction::Input));
-    for line in 0..2u32 {
+    for line in Towline::ALL {
         v.extend(shared::towline(line, Direction::Input));
     }
     v.extend(shared::obstacles(Direction::Input));
@@ -711,133 +744,6 @@ fn build() -> ModelDescription {
         );
     }
 
-    // Diagnostics.
-    v.push(exact_output(
-        "admm.iterations".into(),
-        ADMM_ITERATIONS,
-        int_kind(0, 0, i32::MAX),
-        "ADMM iterations of the last sample (the centralized architecture reports its SCP loop count)".into(),
-    ));
-    v.push(exact_output(
-        "admm.converged".into(),
-        ADMM_CONVERGED,
-        VariableKind::Boolean { start: Some(false) },
-        "true when the stopping rule eq. (29) ended the last sample's ADMM; false when it stopped at max_iterations (the last iterate, within every bound, is applied)".into(),
-    ));
-    for tug in 0..2u32 {
-        let n = tug + 1;
-        v.push(real_out(
-            format!("admm.primal_residual{n}"),
-            primal_residual(tug),
-            "",
-            0.0,
-            format!("last primal residual |g_{n} - f_{n}|_2 of tug {n}'s consensus (Algorithm 1, eq. (29)), in the units of the pose [m, m, rad] stacked over the horizon"),
-        ));
-        v.push(real_out(
-            format!("admm.dual_residual{n}"),
-            dual_residual(tug),
-            "",
-            0.0,
-            format!("last dual residual |f_{n}^s - f_{n}^(s-1)|_2 of tug {n} (eq. (28) as printed, without rho)"),
-        ));
-    }
-    v.push(real_out(
-        "controller.compute_time".into(),
-        COMPUTE_TIME,
-        "s",
-        0.0,
-        "wall-clock time of the last sample (guidance and MPC); varies from run to run".into(),
-    ));
-    v.push(exact_output(
-        "controller.fallbacks".into(),
-        FALLBACKS,
-        int_kind(0, 0, i32::MAX),
-        "samples since instantiation whose plan was replaced by the previous plan, shifted (each one is reported with fmi2Warning \"fallback: <reason>\")".into(),
-    ));
-    v.push(exact_output(
-        "controller.samples".into(),
-        SAMPLES,
-        int_kind(0, 0, i32::MAX),
-        "control samples computed since initialization (one per sample_time, not per communication step)".into(),
-    ));
-    for (c, (field, unit)) in [("x", "m"), ("y", "m"), ("psi", "rad")].iter().enumerate() {
-        v.push(real_out(
-            format!("reference.{field}"),
-            reference(c as u32),
-            unit,
-            0.0,
-            format!("reference pose {field} the ship MPC tracked in the last sample (eta_Sd of eq. (8), or the route waypoint in avoidance_scheme 3)"),
-        ));
-    }
-    v.push(exact_output(
-        "guidance.active_waypoint".into(),
-        ACTIVE_WAYPOINT,
-        int_kind(0, 0, i32::MAX),
-        "index of the active waypoint in the route (1 = W_P1; the last is the destination; 0 before the first sample)".into(),
-    ));
-    v.push(exact_output(
-        "guidance.altered".into(),
-        ALTERED,
-        VariableKind::Boolean { start: Some(false) },
-        "true when the reference is the altered waypoint eta_Sn (eq. (10)-(11))".into(),
-    ));
-    v.push(real_out(
-        "guidance.d_ob".into(),
-        D_OB,
-        "m",
-        NO_OBSTACLE_DISTANCE,
-        format!("smallest range-equivalent distance between the tow and any active obstacle (eq. (8)); {NO_OBSTACLE_DISTANCE:e} m when there is none"),
-    ));
-    for line in 0..2u32 {
-        v.push(real_out(
-            format!("towline{}.angle_desired", line + 1),
-            angle_desired(line),
-            "rad",
-            0.0,
-            format!(
-                "towing angle alpha_{} of the applied plan (the tug's formation reference)",
-                line + 1
-            ),
-        ));
-    }
-    for slot in 0..MAX_OBSTACLES as u32 {
-        let k = slot + 1;
-        v.push(exact_output(
-            format!("colregs[{k}].situation"),
-            colregs_situation(slot),
-            int_kind(-1, -1, 6),
-            format!("COLREGS situation with obstacle slot {k}: -1 none (empty slot or static hazard), 0 safe, 1 head-on, 2 crossing give-way, 3 crossing stand-on, 4 overtaking, 5 being overtaken, 6 unclassified (docs/colregs.md)"),
-        ));
-        v.push(exact_output(
-            format!("colregs[{k}].role"),
-            colregs_role(slot),
-            int_kind(0, 0, 2),
-            format!(
-                "the tow's COLREGS role towards obstacle slot {k}: 0 none, 1 give-way, 2 stand-on"
-            ),
-        ));
-    }
-    for h in 0..HORIZON as u32 {
-        for (i, (vessel, what)) in VESSELS.iter().enumerate() {
-            for (axis, name) in ["x", "y"].iter().enumerate() {
-                v.push(real_out(
-                    format!("prediction.{vessel}[{}].{name}", h + 1),
-                    prediction(h, i as u32, axis as u32),
-                    "m",
-                    0.0,
-                    format!(
-                        "{what}: {} predicted by the last sample's plan {} sample(s) ahead",
-                        if axis == 0 {
-                            "North position"
-                        } else {
-                            "East position"
-                        },
-                        h + 1
-                    ),
-                ));
-            }
-        }
-    }
-
+    v.extend(diagnostics::variables());
     INFO.model_description(v)
 }

@@ -332,6 +332,27 @@ fn an_invalid_obstacle_is_an_error_naming_its_slot() {
 }
 
 #[test]
+fn unknown_value_references_of_every_type_are_errors_naming_reference_and_type() {
+    testing::assert_unknown_references_are_errors(support::exports(), &DESCRIPTION);
+    testing::assert_model_refuses_unknown_references::<towing_controller::ControllerFmu>(
+        &DESCRIPTION,
+    );
+}
+
+/// The kind is converted from the FMI Integer when it is set: a code other than 0, 1, 2 is
+/// refused there, naming the variable and the code, and the slot keeps its kind.
+#[test]
+fn an_unknown_obstacle_kind_is_refused_when_set() {
+    let fmu = initialized("bad-kind");
+    let kind = vars::obstacle(4, vars::OBSTACLE_KIND);
+    assert_eq!(fmu.set_integer(kind, 2), Fmi2Status::Ok);
+    assert_eq!(fmu.set_integer(kind, 3), Fmi2Status::Error);
+    testing::assert_last_message_contains(&fmu, "obstacle[5].kind");
+    testing::assert_last_message_contains(&fmu, "unknown obstacle kind 3");
+    assert_eq!(fmu.get_integer(kind), 2);
+}
+
+#[test]
 fn fmu_state_functions_are_refused_as_declared() {
     let refused = |fmu: &fmi2_slave::testing::Fmu,
                    (status, state): (Fmi2Status, fmi2_slave::ffi::Fmi2FmuState)| {

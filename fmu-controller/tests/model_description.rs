@@ -5,11 +5,11 @@
 
 use fmi2_slave::{Causality, VariableKind};
 use towing_control::ControllerConfig;
-use towing_controller::variables::{model_description_xml, DESCRIPTION};
+use towing_controller::variables::{model_description_xml, DESCRIPTION, VARIABLES};
 use towing_interface::testing;
 use towing_model::Scenario;
 
-towing_interface::model_description_tests!(DESCRIPTION);
+towing_interface::model_description_tests!(DESCRIPTION, VARIABLES);
 
 #[test]
 fn fmu_state_capabilities_are_declared_false() {

@@ -3,6 +3,7 @@
 //! step the FMU copies what they need into a [`StepSnapshot`] (a few hundred bytes, no
 //! allocation), and the log's writer thread builds, serializes and compresses them.
 
+use towing_interface::codec::obstacle_kind_code;
 use towing_log::scene::{self, colors};
 use towing_log::topics::{
     names, FrameTransforms, LinePrimitive, Log, ObstacleState, Obstacles, PlantInputs, SceneEntity,
@@ -11,7 +12,8 @@ use towing_log::topics::{
 use towing_log::{LogError, LogWriter};
 use towing_model::towline::attachment_point;
 use towing_model::{
-    ObstacleOutput, ObstacleShape, Scenario, TowlineOutput, World, WorldInputs, MAX_OBSTACLES,
+    ObstacleKind, ObstacleShape, ObstacleSlot, Scenario, TowlineOutput, World, WorldInputs,
+    MAX_OBSTACLES,
 };
 
 /// Buffer `d_S0` (m) of the safe circles drawn around static hazards: Du et al. 2022,
@@ -160,7 +162,7 @@ pub struct StepSnapshot {
     /// Towline ends `[ship point, tug point]` (NED, m) of towline 1 and 2.
     pub towline_ends: [[[f64; 2]; 2]; 2],
     /// Every obstacle slot.
-    pub obstacles: [ObstacleOutput; MAX_OBSTACLES],
+    pub obstacles: [ObstacleSlot; MAX_OBSTACLES],
     /// The inputs used for the step that ended at `t`.
     pub inputs: WorldInputs,
 }
@@ -268,11 +270,11 @@ pub fn write_state(
         .obstacles
         .iter()
         .enumerate()
-        .filter(|(_, o)| o.kind != 0)
+        .filter(|(_, o)| o.kind != ObstacleKind::None)
         .map(|(slot, o)| ObstacleState {
             slot: slot as u32 + 1,
             name: info.obstacle_names.get(slot).cloned().unwrap_or_default(),
-            kind: o.kind,
+            kind: obstacle_kind_code(o.kind),
             x: o.x,
             y: o.y,
             psi: o.psi,
@@ -307,7 +309,8 @@ fn moving_scene(snap: &StepSnapshot, obstacles: &[ObstacleState]) -> SceneUpdate
         ));
     }
     let mut targets = SceneEntity::new("targets", t);
-    for o in obstacles.iter().filter(|o| o.kind == 2) {
+    let vessel = obstacle_kind_code(ObstacleKind::VesselEllipse);
+    for o in obstacles.iter().filter(|o| o.kind == vessel) {
         targets.cylinders.push(scene::cylinder(
             o.x,
             o.y,

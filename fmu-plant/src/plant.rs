@@ -9,18 +9,20 @@
 //! ends (with the state at the start time) and gets every topic after each step; terminate
 //! closes it (a failure is `fmi2Error`), and `fmi2FreeInstance` closes it if terminate did
 //! not. The log is the instance's own: it is not part of the FMU state, and the copies the
-//! layer keeps for FMU states share it.
+//! layer keeps for FMU states share it. Loading the scenario and the log's life cycle are
+//! `towing-interface`'s [`RunSession`], which the controller uses too.
 
 use crate::logging::{self, LogScenario, StepSnapshot};
-use crate::variables as vars;
-use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome};
-use std::path::{Path, PathBuf};
+use crate::variables::{self as vars, PlantVariable};
+use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome, ValueType};
 use std::sync::Arc;
-use towing_interface::ScenarioFile;
+use towing_interface::codec::{
+    obstacle_kind_code, ContractVariable, ObstacleField, TowlineField, Vessel,
+};
+use towing_interface::{LogHeader, RunSession, ScenarioFile};
 use towing_log::topics::Log;
-use towing_log::{LogOptions, RunInfo, SharedLog};
 use towing_model::{
-    HullModel, Scenario, TowlineModel, World, WorldConfig, WorldInputs, MAX_OBSTACLES,
+    HullModel, ObstacleSlot, Scenario, TowlineModel, TowlineOutput, World, WorldConfig, WorldInputs,
 };
 
 /// Version of [`Plant`]'s serialized state; bump on any layout change.
@@ -31,8 +33,6 @@ const STATE_MAGIC: &[u8; 4] = b"TWPL";
 /// default: as the scenario says, the bundled scenario.
 #[derive(Debug, Clone, PartialEq)]
 struct Parameters {
-    scenario: String,
-    log_file: String,
     /// Interval of the Foxglove topics `/tf` and `/plant/scene` in the log, s; 0: every step.
     log_scene_interval: f64,
     hull_model: i32,
@@ -43,8 +43,6 @@ struct Parameters {
 impl Default for Parameters {
     fn default() -> Self {
         Self {
-            scenario: String::new(),
-            log_file: String::new(),
             log_scene_interval: vars::LOG_SCENE_INTERVAL_START,
             hull_model: 0,
             towline_model: 0,
@@ -105,14 +103,12 @@ impl Parameters {
     }
 }
 
-/// A scenario as loaded: its text (so a saved FMU state does not depend on the file still
-/// existing), where it came from, and the world built from it.
+/// What the plant builds from the loaded scenario: the world, and what the log needs from
+/// the scenario.
 #[derive(Debug, Clone)]
-struct Loaded {
-    origin: String,
-    text: String,
+struct Built {
     world: World,
-    /// What the log needs from the scenario (shared with the log's writer thread).
+    /// Shared with the log's writer thread.
     log_info: Arc<LogScenario>,
 }
 
@@ -121,42 +117,43 @@ struct Loaded {
 pub struct Plant {
     params: Parameters,
     inputs: WorldInputs,
-    resource_dir: Option<PathBuf>,
     /// Set once initialization mode was entered: parameter changes then reload at once.
     initializing: bool,
-    loaded: Option<Loaded>,
+    /// `scenario`, `log_file`, the scenario as loaded and the MCAP log (open from the end
+    /// of initialization while `log_file` is set).
+    session: RunSession,
+    /// The world of the loaded scenario.
+    built: Option<Built>,
     /// `fmi2SetupExperiment`'s start time (s).
     start_time: f64,
-    /// The MCAP log, open from the end of initialization while `log_file` is set.
-    log: SharedLog,
 }
 
 impl Plant {
     /// Reads the scenario named by the `scenario` parameter (or the bundled one) and builds the world.
     fn load(&mut self, log: &Logger) -> Result<(), String> {
         self.params.validate()?;
-        let ScenarioFile {
-            origin,
-            text,
-            scenario,
-        } = ScenarioFile::load(&self.params.scenario, self.resource_dir.as_deref())?;
-        let world = World::new(&scenario, self.params.world_config(&scenario))
-            .map_err(|e| format!("{origin}: {e}"))?;
-        let log_info = Arc::new(LogScenario::of(&scenario));
-        log.info(
-            "logEvents",
-            &format!(
-                "scenario '{}' loaded from {origin} ({} obstacles)",
-                scenario.name,
-                scenario.obstacles.len()
-            ),
-        );
-        self.loaded = Some(Loaded {
-            origin,
-            text,
-            world,
-            log_info,
-        });
+        let params = &self.params;
+        let built = self.session.load(|file| {
+            let scenario = &file.scenario;
+            let world = World::new(scenario, params.world_config(scenario))
+                .map_err(|e| format!("{}: {e}", file.origin))?;
+            Ok(Built {
+                world,
+                log_info: Arc::new(LogScenario::of(scenario)),
+            })
+        })?;
+        if let Some(file) = self.session.loaded() {
+            log.info(
+                "logEvents",
+                &format!(
+                    "scenario '{}' loaded from {} ({} obstacles)",
+                    file.scenario.name,
+                    file.origin,
+                    file.scenario.obstacles.len()
+                ),
+            );
+        }
+        self.built = Some(built);
         Ok(())
     }
 
@@ -169,68 +166,56 @@ impl Plant {
     }
 
     fn world(&self) -> Option<&World> {
-        self.loaded.as_ref().map(|l| &l.world)
+        self.built.as_ref().map(|b| &b.world)
     }
 
     /// Creates the log named by `log_file` (if any) and writes the run description, the
     /// static scene and the state at the start time.
     fn open_log(&mut self, log: &Logger) -> Result<(), String> {
-        // A log of an earlier initialization (after fmi2Reset) is closed by `release`.
-        if self.params.log_file.is_empty() {
-            return Ok(());
-        }
-        let Some(loaded) = self.loaded.as_ref() else {
+        let Some(built) = self.built.as_ref() else {
             return Ok(());
         };
         let t = self.start_time;
         let guid = vars::DESCRIPTION.guid();
         let p = &self.params;
         let parameters = serde_json::json!({
-            "scenario": p.scenario,
-            "log_file": p.log_file,
+            "scenario": self.session.scenario_parameter(),
+            "log_file": self.session.log_file(),
             "log_scene_interval": p.log_scene_interval,
             "hull_model": p.hull_model,
             "towline_model": p.towline_model,
             "integration_step": p.integration_step,
         });
-        let info = RunInfo {
+        let header = LogHeader {
             unit: vars::MODEL_IDENTIFIER,
             guid: &guid,
             version: env!("CARGO_PKG_VERSION"),
-            scenario: &p.scenario,
-            scenario_name: &loaded.log_info.name,
             start_time: t,
             parameters,
-            scenario_text: &loaded.text,
         };
+        let inputs = &self.inputs;
         // Written before the log's own thread takes over.
-        self.log = SharedLog::open(&p.log_file, LogOptions::default(), &info, |writer| {
+        self.session.open_log(log, header, |writer| {
             logging::register_topics(writer)?;
-            logging::write_static_scene(writer, t, &loaded.world, &loaded.log_info)?;
-            let snap = StepSnapshot::capture(t, &loaded.world, &self.inputs);
-            logging::write_state(writer, &snap, &loaded.log_info, true)
+            logging::write_static_scene(writer, t, &built.world, &built.log_info)?;
+            let snap = StepSnapshot::capture(t, &built.world, inputs);
+            logging::write_state(writer, &snap, &built.log_info, true)
         })
-        .map_err(|e| format!("parameter `log_file`: {e}"))?;
-        log.info(
-            "logEvents",
-            &format!("MCAP log {} created", self.params.log_file),
-        );
-        Ok(())
     }
 
     /// Writes the state at the end `t` of the step that began at `t_prev`; the Foxglove
     /// topics only when the step crossed a multiple of `log_scene_interval` (counted from
     /// the start time). A logging failure becomes a warning.
     fn log_step(&self, t_prev: f64, t: f64) -> Option<String> {
-        let loaded = self.loaded.as_ref()?;
-        let snap = StepSnapshot::capture(t, &loaded.world, &self.inputs);
-        let info = Arc::clone(&loaded.log_info);
+        let built = self.built.as_ref()?;
+        let snap = StepSnapshot::capture(t, &built.world, &self.inputs);
+        let info = Arc::clone(&built.log_info);
         let scene = logging::scene_due(
             self.params.log_scene_interval,
             t_prev - self.start_time,
             t - self.start_time,
         );
-        self.log.batch(Box::new(move |w| {
+        self.session.log().batch(Box::new(move |w| {
             logging::write_state(w, &snap, &info, scene)
         }))
     }
@@ -238,7 +223,7 @@ impl Plant {
     /// Writes a warning or error the plant reports to `/plant/log`.
     fn log_line(&self, t: f64, level: i32, message: &str) -> Option<String> {
         let message = message.to_owned();
-        self.log.batch(Box::new(move |w| {
+        self.session.log().batch(Box::new(move |w| {
             logging::write_log_line(w, t, level, &message)
         }))
     }
@@ -253,11 +238,10 @@ impl Fmi2Model for Plant {
         Ok(Self {
             params: Parameters::default(),
             inputs: WorldInputs::default(),
-            resource_dir: ctx.resource_dir.map(Path::to_path_buf),
             initializing: false,
-            loaded: None,
+            session: RunSession::new(ctx.resource_dir),
+            built: None,
             start_time: 0.0,
-            log: SharedLog::none(),
         })
     }
 
@@ -279,138 +263,119 @@ impl Fmi2Model for Plant {
 
     fn exit_initialization_mode(&mut self, log: &Logger) -> Result<(), String> {
         self.initializing = false;
-        match self.loaded {
+        match self.built {
             Some(_) => self.open_log(log),
             None => Err("no scenario is loaded".to_owned()),
         }
     }
 
-    fn get_real(&self, vr: u32) -> f64 {
-        match vr {
-            vars::INTEGRATION_STEP => self.params.integration_step,
-            vars::LOG_SCENE_INTERVAL => self.params.log_scene_interval,
-            200..=299 => {
-                for tug in 0..2 {
-                    for c in 0..3 {
-                        if vr == vars::tug_force(tug, c) {
-                            return self.inputs.tug_tau[tug as usize][c as usize];
-                        }
-                    }
-                }
-                for line in 0..2 {
-                    if vr == vars::tension_cmd(line) {
-                        return self.inputs.tension_cmd[line as usize];
-                    }
-                }
-                f64::NAN
+    fn get_real(&self, vr: u32) -> Result<f64, String> {
+        use ContractVariable as C;
+        Ok(match vars::VARIABLES.decode(ValueType::Real, vr)? {
+            PlantVariable::IntegrationStep => self.params.integration_step,
+            PlantVariable::LogSceneInterval => self.params.log_scene_interval,
+            PlantVariable::Contract(C::TugForce(tug, c)) => {
+                self.inputs.tug_tau[tug.index()][c.index()]
             }
-            _ => self.world().map_or(0.0, |w| output_real(w, vr)),
-        }
+            PlantVariable::Contract(C::TensionCmd(line)) => self.inputs.tension_cmd[line.index()],
+            PlantVariable::Contract(c) => real_output(self.world(), c).ok_or_else(|| {
+                vars::VARIABLES.unhandled(ValueType::Real, PlantVariable::Contract(c), "get")
+            })?,
+            other => return Err(vars::VARIABLES.unhandled(ValueType::Real, other, "get")),
+        })
     }
 
     fn set_real(&mut self, log: &Logger, vr: u32, value: f64) -> Result<(), String> {
-        if vr == vars::LOG_SCENE_INTERVAL {
-            let previous = self.params.log_scene_interval;
-            self.params.log_scene_interval = value;
-            return self.params.validate().inspect_err(|_| {
-                self.params.log_scene_interval = previous;
-            });
-        }
-        if vr == vars::INTEGRATION_STEP {
-            let previous = self.params.clone();
-            self.params.integration_step = value;
-            if let Err(e) = self
-                .params
-                .validate()
-                .and_then(|()| self.reload_if_initializing(log))
-            {
-                self.params = previous;
-                return Err(e);
+        use ContractVariable as C;
+        match vars::VARIABLES.decode(ValueType::Real, vr)? {
+            PlantVariable::LogSceneInterval => {
+                let previous = self.params.log_scene_interval;
+                self.params.log_scene_interval = value;
+                self.params.validate().inspect_err(|_| {
+                    self.params.log_scene_interval = previous;
+                })
             }
-            return Ok(());
-        }
-        for tug in 0..2 {
-            for c in 0..3 {
-                if vr == vars::tug_force(tug, c) {
-                    self.inputs.tug_tau[tug as usize][c as usize] = value;
-                    return Ok(());
-                }
+            PlantVariable::IntegrationStep => {
+                let previous = self.params.clone();
+                self.params.integration_step = value;
+                self.params
+                    .validate()
+                    .and_then(|()| self.reload_if_initializing(log))
+                    .inspect_err(|_| self.params = previous)
             }
-        }
-        for line in 0..2 {
-            if vr == vars::tension_cmd(line) {
-                self.inputs.tension_cmd[line as usize] = value;
-                return Ok(());
+            PlantVariable::Contract(C::TugForce(tug, c)) => {
+                self.inputs.tug_tau[tug.index()][c.index()] = value;
+                Ok(())
             }
+            PlantVariable::Contract(C::TensionCmd(line)) => {
+                self.inputs.tension_cmd[line.index()] = value;
+                Ok(())
+            }
+            _ => Err(format!("value reference {vr} is not a settable Real")),
         }
-        Err(format!("value reference {vr} is not a settable Real"))
     }
 
-    fn get_integer(&self, vr: u32) -> i32 {
-        match vr {
-            vars::HULL_MODEL => self.params.hull_model,
-            vars::TOWLINE_MODEL => self.params.towline_model,
-            _ => {
-                let slot = (vr.saturating_sub(1000) / 10) as usize;
-                match self.world() {
-                    Some(w) if slot < MAX_OBSTACLES => w.obstacle(slot).kind,
-                    _ => 0,
-                }
-            }
-        }
+    fn get_integer(&self, vr: u32) -> Result<i32, String> {
+        use ContractVariable as C;
+        Ok(match vars::VARIABLES.decode(ValueType::Integer, vr)? {
+            PlantVariable::HullModel => self.params.hull_model,
+            PlantVariable::TowlineModel => self.params.towline_model,
+            PlantVariable::Contract(C::Obstacle(slot, ObstacleField::Kind)) => self
+                .world()
+                .map_or(0, |w| obstacle_kind_code(w.obstacle(slot.index()).kind)),
+            other => return Err(vars::VARIABLES.unhandled(ValueType::Integer, other, "get")),
+        })
     }
 
     fn set_integer(&mut self, log: &Logger, vr: u32, value: i32) -> Result<(), String> {
         let previous = self.params.clone();
-        match vr {
-            vars::HULL_MODEL => self.params.hull_model = value,
-            vars::TOWLINE_MODEL => self.params.towline_model = value,
+        match vars::VARIABLES.decode(ValueType::Integer, vr)? {
+            PlantVariable::HullModel => self.params.hull_model = value,
+            PlantVariable::TowlineModel => self.params.towline_model = value,
             _ => return Err(format!("value reference {vr} is not a settable Integer")),
         }
-        if let Err(e) = self
-            .params
+        self.params
             .validate()
             .and_then(|()| self.reload_if_initializing(log))
-        {
-            self.params = previous;
-            return Err(e);
-        }
-        Ok(())
+            .inspect_err(|_| self.params = previous)
     }
 
-    fn get_boolean(&self, vr: u32) -> bool {
-        for line in 0..2 {
-            if vr == vars::towline(line, vars::TOWLINE_SLACK) {
-                return self.world().is_none_or(|w| w.towline(line as usize).slack);
+    fn get_boolean(&self, vr: u32) -> Result<bool, String> {
+        match vars::VARIABLES.decode(ValueType::Boolean, vr)? {
+            PlantVariable::Contract(ContractVariable::Towline(line, TowlineField::Slack)) => {
+                Ok(self.world().is_none_or(|w| w.towline(line.index()).slack))
             }
+            other => Err(vars::VARIABLES.unhandled(ValueType::Boolean, other, "get")),
         }
-        false
     }
 
     fn set_boolean(&mut self, _log: &Logger, vr: u32, _value: bool) -> Result<(), String> {
+        vars::VARIABLES.decode(ValueType::Boolean, vr)?;
         Err(format!("value reference {vr} is not a settable Boolean"))
     }
 
-    fn get_string(&self, vr: u32) -> String {
-        match vr {
-            vars::SCENARIO => self.params.scenario.clone(),
-            vars::LOG_FILE => self.params.log_file.clone(),
-            _ => String::new(),
+    fn get_string(&self, vr: u32) -> Result<String, String> {
+        match vars::VARIABLES.decode(ValueType::String, vr)? {
+            PlantVariable::Contract(ContractVariable::Scenario) => {
+                Ok(self.session.scenario_parameter().to_owned())
+            }
+            PlantVariable::Contract(ContractVariable::LogFile) => {
+                Ok(self.session.log_file().to_owned())
+            }
+            other => Err(vars::VARIABLES.unhandled(ValueType::String, other, "get")),
         }
     }
 
     fn set_string(&mut self, log: &Logger, vr: u32, value: &str) -> Result<(), String> {
-        match vr {
-            vars::SCENARIO => {
-                let previous = std::mem::replace(&mut self.params.scenario, value.to_owned());
-                if let Err(e) = self.reload_if_initializing(log) {
-                    self.params.scenario = previous;
-                    return Err(e);
-                }
-                Ok(())
+        match vars::VARIABLES.decode(ValueType::String, vr)? {
+            PlantVariable::Contract(ContractVariable::Scenario) => {
+                let previous = self.session.replace_scenario_parameter(value);
+                self.reload_if_initializing(log).inspect_err(|_| {
+                    self.session.replace_scenario_parameter(&previous);
+                })
             }
-            vars::LOG_FILE => {
-                value.clone_into(&mut self.params.log_file);
+            PlantVariable::Contract(ContractVariable::LogFile) => {
+                self.session.set_log_file(value);
                 Ok(())
             }
             _ => Err(format!("value reference {vr} is not a settable String")),
@@ -418,19 +383,19 @@ impl Fmi2Model for Plant {
     }
 
     fn do_step(&mut self, _log: &Logger, step: &StepContext) -> StepOutcome {
-        let Some(loaded) = self.loaded.as_mut() else {
+        let Some(built) = self.built.as_mut() else {
             return StepOutcome::Error("no scenario is loaded".to_owned());
         };
-        let outcome = match loaded.world.step(&self.inputs, step.step_size) {
+        let outcome = match built.world.step(&self.inputs, step.step_size) {
             Ok(()) => StepOutcome::Ok,
             Err(e) => StepOutcome::Discard(format!(
                 "step from t = {} s by h = {} s refused: {e}; the state is left at t = {} s",
                 step.current_time,
                 step.step_size,
-                loaded.world.time()
+                built.world.time()
             )),
         };
-        if !self.log.is_active() {
+        if !self.session.log().is_active() {
             return outcome;
         }
         let failed = match &outcome {
@@ -451,22 +416,17 @@ impl Fmi2Model for Plant {
     }
 
     fn terminate(&mut self, _log: &Logger) -> Result<(), String> {
-        self.log
-            .finish()
-            .map(drop)
-            .map_err(|e| format!("closing the log: {e}"))
+        self.session.terminate()
     }
 
     fn release(&mut self, log: &Logger) {
-        if let Err(e) = self.log.finish() {
-            log.error(&format!("closing the log: {e}"));
-        }
+        self.session.release(log);
     }
 
     fn serialize_state(&self, out: &mut Vec<u8>) {
         out.extend_from_slice(STATE_MAGIC);
         out.extend_from_slice(&STATE_FORMAT_VERSION.to_le_bytes());
-        put_str(out, &self.params.scenario);
+        put_str(out, self.session.scenario_parameter());
         out.extend_from_slice(&self.params.hull_model.to_le_bytes());
         out.extend_from_slice(&self.params.towline_model.to_le_bytes());
         out.extend_from_slice(&self.params.integration_step.to_le_bytes());
@@ -479,16 +439,16 @@ impl Fmi2Model for Plant {
             out.extend_from_slice(&x.to_le_bytes());
         }
         out.push(u8::from(self.initializing));
-        match &self.loaded {
-            None => out.push(0),
-            Some(l) => {
+        match (self.session.loaded(), &self.built) {
+            (Some(file), Some(built)) => {
                 out.push(1);
-                put_str(out, &l.origin);
-                put_str(out, &l.text);
+                put_str(out, &file.origin);
+                put_str(out, &file.text);
                 let mut world = Vec::new();
-                l.world.write_state(&mut world);
+                built.world.write_state(&mut world);
                 put_bytes(out, &world);
             }
+            _ => out.push(0),
         }
     }
 
@@ -503,9 +463,8 @@ impl Fmi2Model for Plant {
                 "TowingPlant state format version {version} is not supported (this build reads {STATE_FORMAT_VERSION})"
             ));
         }
+        let scenario_parameter = r.string()?;
         let params = Parameters {
-            scenario: r.string()?,
-            log_file: String::new(),
             log_scene_interval: self.params.log_scene_interval,
             hull_model: i32::from_le_bytes(r.array()?),
             towline_model: i32::from_le_bytes(r.array()?),
@@ -522,39 +481,31 @@ impl Fmi2Model for Plant {
         }
         let initializing = r.take(1)?[0] != 0;
         let mut restored = Self {
-            params: Parameters {
-                // The log is the instance's own, not part of the state.
-                log_file: self.params.log_file.clone(),
-                ..params
-            },
+            params,
             inputs,
-            resource_dir: self.resource_dir.clone(),
             initializing,
-            loaded: None,
+            // The log, `log_file` and the resources folder are the instance's own, not part
+            // of the state.
+            session: self.session.clone(),
+            built: None,
             start_time: self.start_time,
-            log: self.log.clone(),
         };
+        let mut loaded = None;
         if r.take(1)?[0] == 1 {
             let origin = r.string()?;
             let text = r.string()?;
             let world_bytes = r.bytes()?;
             restored.params.validate()?;
-            let ScenarioFile {
-                origin,
-                text,
-                scenario,
-            } = ScenarioFile::parse(origin, text)?;
-            let config = restored.params.world_config(&scenario);
-            let mut world = World::new(&scenario, config).map_err(|e| format!("{origin}: {e}"))?;
+            let file = ScenarioFile::parse(origin, text)?;
+            let config = restored.params.world_config(&file.scenario);
+            let mut world =
+                World::new(&file.scenario, config).map_err(|e| format!("{}: {e}", file.origin))?;
             world.read_state(world_bytes)?;
-            let log_info = Arc::new(LogScenario::of(&scenario));
-            restored.loaded = Some(Loaded {
-                origin,
-                text,
-                world,
-                log_info,
-            });
+            let log_info = Arc::new(LogScenario::of(&file.scenario));
+            restored.built = Some(Built { world, log_info });
+            loaded = Some(file);
         }
+        restored.session.restore(scenario_parameter, loaded);
         if r.pos != bytes.len() {
             return Err(format!(
                 "TowingPlant state has {} trailing bytes",
@@ -566,44 +517,33 @@ impl Fmi2Model for Plant {
     }
 }
 
-/// Real outputs read from the world.
-fn output_real(w: &World, vr: u32) -> f64 {
-    match vr {
-        100..=125 => {
-            let vessel = (vr - 100) / 10;
-            let c = ((vr - 100) % 10) as usize;
+/// The Real output `c` of the world (0 before a scenario is loaded); `None` when `c` is not
+/// a Real output of the plant.
+fn real_output(world: Option<&World>, c: ContractVariable) -> Option<f64> {
+    let read = |f: &dyn Fn(&World) -> f64| Some(world.map_or(0.0, f));
+    match c {
+        ContractVariable::VesselState(vessel, component) => read(&|w| {
             let state = match vessel {
-                0 => w.ship(),
-                1 => w.tug(0),
-                _ => w.tug(1),
+                Vessel::Ship => w.ship(),
+                Vessel::Tug1 => w.tug(0),
+                Vessel::Tug2 => w.tug(1),
             };
-            if c < 3 {
-                state.eta[c]
-            } else {
-                state.nu[c - 3]
-            }
+            component.of(state)
+        }),
+        ContractVariable::Towline(line, field) => {
+            let value: fn(&TowlineOutput) -> f64 = match field {
+                TowlineField::Length => |l| l.length,
+                TowlineField::Angle => |l| l.angle,
+                TowlineField::Tension => |l| l.tension,
+                TowlineField::Slack => return None,
+            };
+            read(&|w| value(&w.towline(line.index())))
         }
-        300..=313 => {
-            let line = w.towline(((vr - 300) / 10) as usize);
-            match (vr - 300) % 10 {
-                0 => line.length,
-                1 => line.angle,
-                _ => line.tension,
-            }
+        ContractVariable::Obstacle(slot, field) => {
+            field.of(&ObstacleSlot::EMPTY)?;
+            read(&|w| field.of(&w.obstacle(slot.index())).unwrap_or(f64::NAN))
         }
-        _ => {
-            let slot = ((vr - 1000) / 10) as usize;
-            let o = w.obstacle(slot);
-            match (vr - 1000) % 10 {
-                0 => o.x,
-                1 => o.y,
-                2 => o.psi,
-                3 => o.speed,
-                4 => o.length,
-                5 => o.width,
-                _ => f64::NAN,
-            }
-        }
+        _ => None,
     }
 }
 

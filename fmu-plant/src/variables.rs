@@ -8,10 +8,17 @@
 //! commands as inputs) and their value references, units and declared types are those of
 //! the interface contract, `towing-interface` (with the String parameters `scenario` and
 //! `log_file`); this module adds the plant's own parameters (value references 2..=9) and
-//! the Boolean outputs `towlineN.slack` (`vr::towline(line, 3)`).
+//! the Boolean outputs `towlineN.slack` (the contract's [`TowlineField::Slack`]).
+//!
+//! The plant's getters and setters decode every value reference through [`VARIABLES`]
+//! into a [`PlantVariable`] and match on it.
 
 use fmi2_slave::description::{ModelDescription, VariableKind};
+use fmi2_slave::ValueType;
 use std::sync::LazyLock;
+use towing_interface::codec::{
+    ContractVariable, ModelVariable, Towline, TowlineField, VariableTable,
+};
 use towing_interface::types::real_kind;
 use towing_interface::variables::{self as shared, parameter, Direction};
 use towing_interface::ModelInfo;
@@ -33,8 +40,64 @@ pub const LOG_SCENE_INTERVAL: u32 = 5;
 /// Start value of `log_scene_interval`, s.
 pub const LOG_SCENE_INTERVAL_START: f64 = 0.5;
 
-/// Field index of the Boolean `towlineN.slack` output within a towline's value references.
-pub const TOWLINE_SLACK: u32 = 3;
+/// A variable of the plant, as its getters and setters see it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PlantVariable {
+    /// A variable of the interface contract: the plant declares every one (the commands as
+    /// inputs, the rest as outputs, `towlineN.slack` its own).
+    Contract(ContractVariable),
+    /// `log_scene_interval` (Real parameter, s).
+    LogSceneInterval,
+    /// `hull_model` (Integer parameter).
+    HullModel,
+    /// `towline_model` (Integer parameter).
+    TowlineModel,
+    /// `integration_step` (Real parameter, s).
+    IntegrationStep,
+}
+
+impl ModelVariable for PlantVariable {
+    fn value_reference(self) -> u32 {
+        match self {
+            PlantVariable::Contract(c) => c.encode(),
+            PlantVariable::LogSceneInterval => LOG_SCENE_INTERVAL,
+            PlantVariable::HullModel => HULL_MODEL,
+            PlantVariable::TowlineModel => TOWLINE_MODEL,
+            PlantVariable::IntegrationStep => INTEGRATION_STEP,
+        }
+    }
+
+    fn value_type(self) -> ValueType {
+        match self {
+            PlantVariable::Contract(c) => c.value_type(),
+            PlantVariable::LogSceneInterval | PlantVariable::IntegrationStep => ValueType::Real,
+            PlantVariable::HullModel | PlantVariable::TowlineModel => ValueType::Integer,
+        }
+    }
+
+    fn contract(self) -> Option<ContractVariable> {
+        match self {
+            PlantVariable::Contract(c) => Some(c),
+            _ => None,
+        }
+    }
+}
+
+/// The plant's variables by value reference, built once.
+pub static VARIABLES: LazyLock<VariableTable<PlantVariable>> = LazyLock::new(|| {
+    let own = [
+        PlantVariable::LogSceneInterval,
+        PlantVariable::HullModel,
+        PlantVariable::TowlineModel,
+        PlantVariable::IntegrationStep,
+    ];
+    VariableTable::new(
+        MODEL_IDENTIFIER,
+        ContractVariable::all()
+            .map(PlantVariable::Contract)
+            .chain(own),
+    )
+});
 
 /// The plant's model-description header.
 pub const INFO: ModelInfo = ModelInfo {
@@ -112,12 +175,13 @@ fn build() -> ModelDescription {
     ];
     v.extend(shared::commands(Direction::Input));
     v.extend(shared::vessel_states(Direction::Output));
-    for line in 0..2u32 {
-        let n = line + 1;
+    for line in Towline::ALL {
+        let n = line.index() + 1;
+        let slack = ContractVariable::Towline(line, TowlineField::Slack);
         v.extend(shared::towline(line, Direction::Output));
         v.push(shared::calculated_output(
-            format!("towline{n}.slack"),
-            towline(line, TOWLINE_SLACK),
+            slack.name(),
+            slack.encode(),
             VariableKind::Boolean { start: None },
             format!("true when towline {n} transmitted no force at the end of the last step"),
             vec![],

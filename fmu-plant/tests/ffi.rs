@@ -123,6 +123,12 @@ fn unknown_value_reference_is_an_error_naming_it() {
 }
 
 #[test]
+fn unknown_value_references_of_every_type_are_errors_naming_reference_and_type() {
+    testing::assert_unknown_references_are_errors(exports(), &DESCRIPTION);
+    testing::assert_model_refuses_unknown_references::<towing_plant::Plant>(&DESCRIPTION);
+}
+
+#[test]
 fn non_finite_inputs_are_refused_naming_the_variable_and_keeping_the_value() {
     for (i, bad) in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY]
         .into_iter()

@@ -2,4 +2,7 @@
 //! variable table generates (`cargo xtask model-description` regenerates both), and the
 //! contract's names must be declared.
 
-towing_interface::model_description_tests!(towing_plant::variables::DESCRIPTION);
+towing_interface::model_description_tests!(
+    towing_plant::variables::DESCRIPTION,
+    towing_plant::variables::VARIABLES
+);

@@ -665,8 +665,15 @@ pub unsafe fn reset<M: Fmi2Model>(c: Fmi2Component) -> Fmi2Status {
     }
 }
 
+/// The error of a model's getter or setter for `vr`, after the variable's name and value
+/// reference.
+fn model_error(inst: &Instance<impl Fmi2Model>, ty: ValueType, vr: u32, e: &str) -> String {
+    let name = inst.lookup(ty, vr).map(|v| v.name.as_str()).unwrap_or("?");
+    format!("variable '{name}' (vr {vr}): {e}")
+}
+
 /// Shared body of `fmi2Get{Real,Integer,Boolean}`: validate every value reference, then
-/// read.
+/// read; a model's `Err` is the call's `fmi2Error`.
 unsafe fn get_values<M: Fmi2Model, T>(
     c: Fmi2Component,
     func: Func,
@@ -674,7 +681,7 @@ unsafe fn get_values<M: Fmi2Model, T>(
     vr: *const Fmi2ValueReference,
     nvr: usize,
     value: *mut T,
-    get: impl Fn(&M, u32) -> T,
+    get: impl Fn(&M, u32) -> Result<T, String>,
 ) -> Fmi2Status {
     // SAFETY: forwarded FMI contract.
     unsafe {
@@ -685,7 +692,7 @@ unsafe fn get_values<M: Fmi2Model, T>(
                 inst.lookup(ty, r)?;
             }
             for (o, &r) in out.iter_mut().zip(vrs) {
-                *o = get(&inst.model, r);
+                *o = get(&inst.model, r).map_err(|e| model_error(inst, ty, r, &e))?;
             }
             Ok(Fmi2Status::Ok)
         })
@@ -717,10 +724,8 @@ unsafe fn set_values<M: Fmi2Model, T: Copy>(
                 check(var, v)?;
             }
             for (&r, &v) in vrs.iter().zip(vals) {
-                set(&mut inst.model, &inst.logger, r, v).map_err(|e| {
-                    let name = inst.lookup(ty, r).map(|v| v.name.as_str()).unwrap_or("?");
-                    format!("variable '{name}' (vr {r}): {e}")
-                })?;
+                set(&mut inst.model, &inst.logger, r, v)
+                    .map_err(|e| model_error(inst, ty, r, &e))?;
             }
             Ok(Fmi2Status::Ok)
         })
@@ -786,11 +791,8 @@ pub unsafe fn get_boolean<M: Fmi2Model>(
             nvr,
             value,
             |m, r| {
-                if m.get_boolean(r) {
-                    FMI2_TRUE
-                } else {
-                    FMI2_FALSE
-                }
+                m.get_boolean(r)
+                    .map(|b| if b { FMI2_TRUE } else { FMI2_FALSE })
             },
         )
     }
@@ -814,7 +816,11 @@ pub unsafe fn get_string<M: Fmi2Model>(
             }
             inst.strings.clear();
             for (o, &r) in out.iter_mut().zip(vrs) {
-                let s = to_cstring(&inst.model.get_string(r));
+                let s = inst
+                    .model
+                    .get_string(r)
+                    .map_err(|e| model_error(inst, ValueType::String, r, &e))?;
+                let s = to_cstring(&s);
                 // The CString's heap buffer does not move when `strings` grows.
                 *o = s.as_ptr();
                 inst.strings.push(s);

@@ -125,8 +125,11 @@ pub enum StepOutcome {
 /// Before any get/set method is called the layer has checked that `vr` names a variable of
 /// that type in [`description`](Self::description), that the call is allowed in the current
 /// state for that variable's causality/variability (FMI 2.0 section 4.2.4), and (Real) that
-/// the value is finite. The model only stores and returns values. An `Err(message)` becomes
-/// `fmi2Error` with the message logged; a panic becomes `fmi2Fatal`.
+/// the value is finite. The model only stores and returns values. An `Err(message)` from a
+/// getter or a setter becomes `fmi2Error` with the message logged after the variable's name
+/// and value reference; a panic becomes `fmi2Fatal`. A model that does not decode a value
+/// reference of its own description (a variable added without its getter) returns `Err`
+/// naming the reference and the FMI type, never panics.
 ///
 /// A vectorised `fmi2Set*` call is checked completely before the first setter runs, so a
 /// layer-detected problem (unknown value reference, wrong causality or state, NaN) leaves
@@ -159,19 +162,19 @@ pub trait Fmi2Model: Clone + Send + Sized + 'static {
     fn exit_initialization_mode(&mut self, log: &Logger) -> Result<(), String>;
 
     /// Value of a Real variable.
-    fn get_real(&self, vr: u32) -> f64;
+    fn get_real(&self, vr: u32) -> Result<f64, String>;
     /// Store a Real variable (finite, settable now).
     fn set_real(&mut self, log: &Logger, vr: u32, value: f64) -> Result<(), String>;
     /// Value of an Integer variable.
-    fn get_integer(&self, vr: u32) -> i32;
+    fn get_integer(&self, vr: u32) -> Result<i32, String>;
     /// Store an Integer variable.
     fn set_integer(&mut self, log: &Logger, vr: u32, value: i32) -> Result<(), String>;
     /// Value of a Boolean variable.
-    fn get_boolean(&self, vr: u32) -> bool;
+    fn get_boolean(&self, vr: u32) -> Result<bool, String>;
     /// Store a Boolean variable.
     fn set_boolean(&mut self, log: &Logger, vr: u32, value: bool) -> Result<(), String>;
     /// Value of a String variable (interior NULs are replaced on the way out).
-    fn get_string(&self, vr: u32) -> String;
+    fn get_string(&self, vr: u32) -> Result<String, String>;
     /// Store a String variable (valid UTF-8).
     fn set_string(&mut self, log: &Logger, vr: u32, value: &str) -> Result<(), String>;
 

@@ -388,15 +388,17 @@ impl Fmu {
         self.set_reals(&[vr], &[value])
     }
 
+    /// `fmi2GetInteger` of one reference; the status and the value.
+    pub fn try_get_integer(&self, vr: u32) -> (Fmi2Status, i32) {
+        let mut v = -1;
+        let s = unsafe { (self.exports.get_integer)(self.c, &vr, 1, &mut v) };
+        (s, v)
+    }
+
     /// `fmi2GetInteger` of one reference, expected OK.
     pub fn get_integer(&self, vr: u32) -> i32 {
-        let mut v = -1;
-        assert_eq!(
-            unsafe { (self.exports.get_integer)(self.c, &vr, 1, &mut v) },
-            Fmi2Status::Ok,
-            "{}",
-            self.log_text()
-        );
+        let (s, v) = self.try_get_integer(vr);
+        assert_eq!(s, Fmi2Status::Ok, "{}", self.log_text());
         v
     }
 
@@ -405,16 +407,18 @@ impl Fmu {
         unsafe { (self.exports.set_integer)(self.c, &vr, 1, &value) }
     }
 
+    /// `fmi2GetBoolean` of one reference; the status and the value.
+    pub fn try_get_boolean(&self, vr: u32) -> (Fmi2Status, bool) {
+        let mut v = -1;
+        let s = unsafe { (self.exports.get_boolean)(self.c, &vr, 1, &mut v) };
+        (s, v != FMI2_FALSE)
+    }
+
     /// `fmi2GetBoolean` of one reference, expected OK.
     pub fn get_boolean(&self, vr: u32) -> bool {
-        let mut v = -1;
-        assert_eq!(
-            unsafe { (self.exports.get_boolean)(self.c, &vr, 1, &mut v) },
-            Fmi2Status::Ok,
-            "{}",
-            self.log_text()
-        );
-        v != FMI2_FALSE
+        let (s, v) = self.try_get_boolean(vr);
+        assert_eq!(s, Fmi2Status::Ok, "{}", self.log_text());
+        v
     }
 
     /// `fmi2SetBoolean` of one reference.
@@ -423,16 +427,23 @@ impl Fmu {
         unsafe { (self.exports.set_boolean)(self.c, &vr, 1, &v) }
     }
 
+    /// `fmi2GetString` of one reference; the status and the value (empty when not OK).
+    pub fn try_get_string(&self, vr: u32) -> (Fmi2Status, String) {
+        let mut p: Fmi2String = ptr::null();
+        let s = unsafe { (self.exports.get_string)(self.c, &vr, 1, &mut p) };
+        let v = if s == Fmi2Status::Ok {
+            unsafe { lossy(p) }
+        } else {
+            String::new()
+        };
+        (s, v)
+    }
+
     /// `fmi2GetString` of one reference, expected OK.
     pub fn get_string(&self, vr: u32) -> String {
-        let mut p: Fmi2String = ptr::null();
-        assert_eq!(
-            unsafe { (self.exports.get_string)(self.c, &vr, 1, &mut p) },
-            Fmi2Status::Ok,
-            "{}",
-            self.log_text()
-        );
-        unsafe { lossy(p) }
+        let (s, v) = self.try_get_string(vr);
+        assert_eq!(s, Fmi2Status::Ok, "{}", self.log_text());
+        v
     }
 
     /// `fmi2SetString` of one reference.

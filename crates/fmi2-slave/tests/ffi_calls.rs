@@ -741,6 +741,25 @@ fn unknown_or_mistyped_value_references_are_named() {
     }
 }
 
+/// A getter's `Err` (here the model refusing `steps` in fault mode 5, as a model refuses a
+/// reference it does not decode) is fmi2Error naming the variable, never fmi2Fatal.
+#[test]
+fn a_getter_error_of_the_model_is_an_error_naming_the_variable() {
+    let f = fresh_in("stepComplete");
+    assert_eq!(f.set_integer(I_FAULT, FAULT_GET), Fmi2Status::Ok);
+    let mut i = 0;
+    unsafe {
+        assert_eq!(fmi2GetInteger(f.c, &I_STEPS, 1, &mut i), Fmi2Status::Error);
+    }
+    assert_eq!(
+        f.last_text(),
+        "fmi2GetInteger: variable 'steps' (vr 2): refused by fault_mode 5"
+    );
+    // The instance is in the error state: only getters, FMU-state functions, reset, free.
+    assert_eq!(f.step(0.0, 0.1), Fmi2Status::Error);
+    assert!(f.last_text().contains("Illegal call sequence"));
+}
+
 #[test]
 fn non_finite_reals_are_rejected_and_a_bad_element_leaves_everything_unchanged() {
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {

@@ -8,7 +8,7 @@
 use std::io::Write;
 
 use towing_control::{AvoidanceScheme, Controller, ControllerConfig, Measurement};
-use towing_model::{Scenario, World, WorldInputs};
+use towing_model::{ObstacleKind, Scenario, World, WorldInputs};
 
 /// Hull outline (rectangle `length x width` at the pose) as boundary samples.
 fn rect_points(eta: [f64; 3], length: f64, width: f64) -> Vec<[f64; 2]> {
@@ -65,12 +65,12 @@ fn overlaps(world: &World, scenario: &Scenario) -> Vec<String> {
         for k in 0..towing_model::MAX_OBSTACLES {
             let o = world.obstacle(k);
             let hit = match o.kind {
-                1 => {
+                ObstacleKind::StaticCircle => {
                     let r = 0.5 * o.length.max(o.width);
                     pts.iter().any(|p| (p[0] - o.x).hypot(p[1] - o.y) < r)
                         || in_rect([o.x, o.y], eta, l, w)
                 }
-                2 => {
+                ObstacleKind::VesselEllipse => {
                     let (a, b) = (0.5 * o.length, 0.5 * o.width);
                     let (sn, cs) = o.psi.sin_cos();
                     let inside = |p: &[f64; 2]| {
@@ -319,7 +319,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         for (k, c) in cpa.iter_mut().enumerate() {
             let o = world.obstacle(k);
-            if o.kind != 2 {
+            if o.kind != ObstacleKind::VesselEllipse {
                 continue;
             }
             let s = world.ship().eta;
@@ -344,7 +344,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // Clearance to every active obstacle (centre distance minus radius, crude).
         for k in 0..towing_model::MAX_OBSTACLES {
             let o = world.obstacle(k);
-            if o.kind == 0 {
+            if o.kind == ObstacleKind::None {
                 continue;
             }
             for p in [world.ship().eta, world.tug(0).eta, world.tug(1).eta] {

@@ -236,12 +236,7 @@ impl ControllerConfig {
     /// # Errors
     /// A route the reference system refuses (e.g. repeated points).
     pub fn route(&self) -> Result<Route, ConfigError> {
-        let r = &self.scenario.route;
-        let points = std::iter::once(&r.origin)
-            .chain(r.waypoints.iter())
-            .chain(std::iter::once(&r.destination))
-            .map(|p| towing_guidance::Pose::new(p.x, p.y, p.psi))
-            .collect();
+        let points = self.scenario.route.points().copied().collect();
         Route::new(points).map_err(|e| ConfigError::new("scenario.route", e.to_string()))
     }
 

@@ -25,10 +25,12 @@
 use std::time::{Duration, Instant};
 
 use towing_guidance::{
-    body_to_ned, role, GuidanceOutput, GuidanceParams, ObstacleInput, Pose, ReferenceSystem, Role,
+    body_to_ned, role, ActiveObstacle, GuidanceOutput, GuidanceParams, ReferenceSystem, Role,
     Situation, TowState,
 };
-use towing_model::{wrap_angle, VesselData, VesselState, World, MAX_OBSTACLES};
+use towing_model::{
+    wrap_angle, ObstacleKind, ObstacleSlot, Pose, VesselData, VesselState, World, MAX_OBSTACLES,
+};
 use towing_mpc::{
     Admm, AppliedCommand, Budget, Centralized, Obstacle, Optimizer, QpOutcome, SampleInput,
     ShipInput, ShipModel, TugInput, HORIZON,
@@ -44,8 +46,8 @@ pub struct Measurement {
     pub ship: [f64; 6],
     /// Tug 1 (aft) and tug 2 (forward), as the ship.
     pub tugs: [[f64; 6]; 2],
-    /// The obstacle slots (`obstacle[k]`, kind 0 = empty).
-    pub obstacles: [ObstacleInput; MAX_OBSTACLES],
+    /// The obstacle slots (`obstacle[k]`).
+    pub obstacles: [ObstacleSlot; MAX_OBSTACLES],
 }
 
 const VESSEL_FIELDS: [&str; 6] = ["x", "y", "psi", "u", "v", "r"];
@@ -69,7 +71,7 @@ impl Measurement {
             }
         }
         for (k, o) in self.obstacles.iter().enumerate() {
-            o.obstacle().map_err(|e| MeasurementError::Obstacle {
+            ActiveObstacle::from_slot(o).map_err(|e| MeasurementError::Obstacle {
                 slot: k + 1,
                 reason: e.to_string(),
             })?;
@@ -89,7 +91,7 @@ impl Measurement {
             ..Measurement::default()
         };
         for (k, slot) in m.obstacles.iter_mut().enumerate() {
-            *slot = world.obstacle(k).into();
+            *slot = world.obstacle(k);
         }
         m
     }
@@ -638,7 +640,9 @@ impl Controller {
         let mut n = 0;
         for (k, o) in m.obstacles.iter().enumerate() {
             // Validated in `sample`.
-            let Ok(Some(_)) = o.obstacle() else { continue };
+            let Ok(Some(_)) = ActiveObstacle::from_slot(o) else {
+                continue;
+            };
             let obstacle = mpc_obstacle(o, ts);
             let range = points
                 .iter()
@@ -685,8 +689,8 @@ fn finite_or(v: f64, default: f64) -> f64 {
 /// the ellipse with semi-axes `L / 2`, `W / 2` along the target's course,
 /// moving on at its course and speed over the horizon (`sample_time` s per
 /// sample).
-fn mpc_obstacle(o: &ObstacleInput, sample_time: f64) -> Obstacle {
-    if o.kind == 1 {
+fn mpc_obstacle(o: &ObstacleSlot, sample_time: f64) -> Obstacle {
+    if o.kind == ObstacleKind::StaticCircle {
         Obstacle::Circle {
             centre: [o.x, o.y],
             radius: 0.5 * o.length.max(o.width),

@@ -5,8 +5,7 @@
 use towing_control::{
     AvoidanceScheme, Controller, ControllerConfig, Measurement, MeasurementError,
 };
-use towing_guidance::ObstacleInput;
-use towing_model::{Scenario, World};
+use towing_model::{ObstacleKind, ObstacleSlot, Scenario, World};
 
 fn paper_measurement() -> (Scenario, Measurement) {
     let scenario = Scenario::paper().unwrap();
@@ -15,15 +14,15 @@ fn paper_measurement() -> (Scenario, Measurement) {
 }
 
 /// A static circle of `diameter` centred on the ship.
-fn circle_on_ship(m: &Measurement, diameter: f64) -> ObstacleInput {
-    ObstacleInput {
+fn circle_on_ship(m: &Measurement, diameter: f64) -> ObstacleSlot {
+    ObstacleSlot {
         x: m.ship[0],
         y: m.ship[1],
         psi: 0.0,
         speed: 0.0,
         length: diameter,
         width: diameter,
-        kind: 1,
+        kind: ObstacleKind::StaticCircle,
     }
 }
 
@@ -88,23 +87,23 @@ fn obstacles_on_top_of_the_tow_give_a_bounded_command_without_fallback_panics() 
     let mut c = Controller::new(config.clone()).unwrap();
     // A static circle on the ship, a target ship on tug 2, another on tug 1.
     m.obstacles[0] = circle_on_ship(&m, 1.0);
-    m.obstacles[1] = ObstacleInput {
+    m.obstacles[1] = ObstacleSlot {
         x: m.tugs[1][0],
         y: m.tugs[1][1],
         psi: 1.0,
         speed: 0.07,
         length: 1.48,
         width: 0.48,
-        kind: 2,
+        kind: ObstacleKind::VesselEllipse,
     };
-    m.obstacles[2] = ObstacleInput {
+    m.obstacles[2] = ObstacleSlot {
         x: m.tugs[0][0],
         y: m.tugs[0][1],
         psi: -2.0,
         speed: 0.07,
         length: 1.48,
         width: 0.48,
-        kind: 2,
+        kind: ObstacleKind::VesselEllipse,
     };
     for _ in 0..5 {
         let r = c.sample(&m).unwrap();
@@ -149,14 +148,14 @@ fn scheme_three_tracks_the_unaltered_route_and_scheme_two_drops_the_distance_cos
     // A target ship head-on, 4 m ahead of the forward tug: the route is altered.
     let psi = m.ship[2];
     let ahead = 2.1 + 4.0;
-    m.obstacles[3] = ObstacleInput {
+    m.obstacles[3] = ObstacleSlot {
         x: m.ship[0] + ahead * psi.cos(),
         y: m.ship[1] + ahead * psi.sin(),
         psi: psi + std::f64::consts::PI,
         speed: 0.07,
         length: 1.48,
         width: 0.48,
-        kind: 2,
+        kind: ObstacleKind::VesselEllipse,
     };
     let run = |scheme| {
         let mut config = ControllerConfig::new(scenario.clone());
@@ -275,14 +274,14 @@ fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
     let psi = m.ship[2];
     // 5 m ahead and 3 m to starboard, heading across the bow to port, closing.
     let (fwd, stb) = (5.0, 3.0);
-    let target = ObstacleInput {
+    let target = ObstacleSlot {
         x: m.ship[0] + fwd * psi.cos() - stb * psi.sin(),
         y: m.ship[1] + fwd * psi.sin() + stb * psi.cos(),
         psi: psi - std::f64::consts::FRAC_PI_2,
         speed: 0.07,
         length: 1.48,
         width: 0.48,
-        kind: 2,
+        kind: ObstacleKind::VesselEllipse,
     };
     m.obstacles[3] = target;
     let margin = ControllerConfig::new(scenario.clone())
@@ -311,7 +310,7 @@ fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
 
     // The target gone: no floor.
     let mut clear = m;
-    clear.obstacles[3].kind = 0;
+    clear.obstacles[3].kind = ObstacleKind::None;
     assert_eq!(c.sample(&clear).unwrap().heading_floor, None);
 
     // Scheme III: no COLREGS logic, no floor.

@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 use crate::distance::Ellipse;
 use crate::error::ParamError;
 use crate::geometry::{cpa, relative_bearing, wrap_angle, Cpa};
-use crate::waypoint::Pose;
+use towing_model::Pose;
 
 /// COLREGS situation of own ship with respect to one target ship. Static hazards
 /// have none.

@@ -30,147 +30,15 @@
 //! distance** with `d_D`: the centre distance for a circle and half the focal sum
 //! (the semi-major axis of the confocal ellipse through `P`) for a ship. Both are
 //! metres of range, equal the centre distance for a round obstacle and tend to it
-//! far away. [`Obstacle::distance_eq9`] and [`Obstacle::safe_distance_eq14`] keep
+//! far away. [`ActiveObstacle::distance_eq9`] and [`ActiveObstacle::safe_distance_eq14`] keep
 //! the paper's own units for the MPC's cost (eq. (13)).
 
 use serde::{Deserialize, Serialize};
 
+use towing_model::{ObstacleKind, ObstacleSlot};
+
 use crate::error::InputError;
 use crate::geometry::dist;
-
-/// Obstacle kind code of the FMI input `kind`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum ObstacleKind {
-    /// Code 0: empty slot or inactive target; ignored.
-    None,
-    /// Code 1: static hazard, a circle (eq. (9), first line).
-    Circle,
-    /// Code 2: target ship, an ellipse along its heading (eq. (9), focal sum).
-    Vessel,
-}
-
-impl ObstacleKind {
-    /// Kind from the FMI code (0, 1, 2); any other code is an error.
-    ///
-    /// # Errors
-    /// [`InputError::UnknownKind`] for codes other than 0, 1, 2.
-    pub fn from_code(code: i32) -> Result<Self, InputError> {
-        match code {
-            0 => Ok(Self::None),
-            1 => Ok(Self::Circle),
-            2 => Ok(Self::Vessel),
-            _ => Err(InputError::UnknownKind { code }),
-        }
-    }
-
-    /// The FMI code.
-    #[must_use]
-    pub fn code(self) -> i32 {
-        match self {
-            Self::None => 0,
-            Self::Circle => 1,
-            Self::Vessel => 2,
-        }
-    }
-}
-
-/// One obstacle as the controller receives it (FMI inputs `obstacle[k].*`).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-pub struct ObstacleInput {
-    /// Centre North (m).
-    pub x: f64,
-    /// Centre East (m).
-    pub y: f64,
-    /// Heading = course over ground (rad); ignored for circles.
-    pub psi: f64,
-    /// Speed over ground (m/s, >= 0); ignored for circles.
-    pub speed: f64,
-    /// Length (m): a ship's length overall (major axis `2 a`) or a circle's diameter.
-    pub length: f64,
-    /// Width (m): a ship's beam (minor axis `2 b`) or a circle's diameter.
-    pub width: f64,
-    /// [`ObstacleKind`] code: 0 none, 1 static circle, 2 vessel ellipse.
-    pub kind: i32,
-}
-
-impl From<towing_model::ObstacleOutput> for ObstacleInput {
-    /// The plant's obstacle slot as the controller reads it (same fields, same
-    /// meaning: `docs/interface.md`).
-    fn from(o: towing_model::ObstacleOutput) -> Self {
-        ObstacleInput {
-            x: o.x,
-            y: o.y,
-            psi: o.psi,
-            speed: o.speed,
-            length: o.length,
-            width: o.width,
-            kind: o.kind,
-        }
-    }
-}
-
-impl ObstacleInput {
-    /// Checks the input and returns the obstacle, or `None` for kind 0 (whose other
-    /// fields are not looked at).
-    ///
-    /// Circles: `R = max(length, width) / 2` (the plant reports the diameter in
-    /// both; the larger one is the conservative choice if they differ).
-    /// Ships: `a = length / 2`, `b = width / 2`, `0 <= width <= length`.
-    ///
-    /// # Errors
-    /// Unknown kind, non-finite field, non-positive length, negative width or
-    /// speed, or a ship wider than long: refused, never clamped.
-    pub fn obstacle(&self) -> Result<Option<Obstacle>, InputError> {
-        let kind = ObstacleKind::from_code(self.kind)?;
-        if kind == ObstacleKind::None {
-            return Ok(None);
-        }
-        let fields = [
-            ("x", self.x),
-            ("y", self.y),
-            ("psi", self.psi),
-            ("speed", self.speed),
-            ("length", self.length),
-            ("width", self.width),
-        ];
-        for (name, value) in fields {
-            if !value.is_finite() {
-                return Err(InputError::NonFiniteObstacle { field: name });
-            }
-        }
-        if self.length <= 0.0 || self.width < 0.0 {
-            return Err(InputError::BadObstacleSize {
-                length: self.length,
-                width: self.width,
-            });
-        }
-        let centre = [self.x, self.y];
-        Ok(Some(match kind {
-            ObstacleKind::Circle => Obstacle::Circle {
-                centre,
-                radius: 0.5 * self.length.max(self.width),
-            },
-            _ => {
-                if self.width > self.length {
-                    return Err(InputError::BadObstacleSize {
-                        length: self.length,
-                        width: self.width,
-                    });
-                }
-                if self.speed < 0.0 {
-                    return Err(InputError::NegativeSpeed { speed: self.speed });
-                }
-                Obstacle::Vessel(Ellipse {
-                    centre,
-                    psi: self.psi,
-                    speed: self.speed,
-                    semi_major: 0.5 * self.length,
-                    semi_minor: 0.5 * self.width,
-                })
-            }
-        }))
-    }
-}
 
 /// A target ship as an ellipse along its heading (Fig. 5).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -225,9 +93,11 @@ impl Ellipse {
     }
 }
 
-/// A validated, active obstacle.
+/// A validated, active obstacle: what an [`ObstacleSlot`] of kind
+/// [`ObstacleKind::StaticCircle`] or [`ObstacleKind::VesselEllipse`] becomes
+/// ([`ActiveObstacle::from_slot`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum Obstacle {
+pub enum ActiveObstacle {
     /// Static hazard.
     Circle {
         /// Centre `(x North, y East)` (m).
@@ -239,13 +109,73 @@ pub enum Obstacle {
     Vessel(Ellipse),
 }
 
-impl Obstacle {
+impl ActiveObstacle {
+    /// Checks an obstacle slot and returns the obstacle, or `None` for
+    /// [`ObstacleKind::None`] (whose other fields are not looked at).
+    ///
+    /// Circles: `R = max(length, width) / 2` (the plant reports the diameter in
+    /// both; the larger one is the conservative choice if they differ).
+    /// Ships: `a = length / 2`, `b = width / 2`, `0 <= width <= length`.
+    ///
+    /// # Errors
+    /// A non-finite field, non-positive length, negative width or speed, or a ship
+    /// wider than long: refused, never clamped.
+    pub fn from_slot(slot: &ObstacleSlot) -> Result<Option<Self>, InputError> {
+        if slot.kind == ObstacleKind::None {
+            return Ok(None);
+        }
+        let fields = [
+            ("x", slot.x),
+            ("y", slot.y),
+            ("psi", slot.psi),
+            ("speed", slot.speed),
+            ("length", slot.length),
+            ("width", slot.width),
+        ];
+        for (name, value) in fields {
+            if !value.is_finite() {
+                return Err(InputError::NonFiniteObstacle { field: name });
+            }
+        }
+        if slot.length <= 0.0 || slot.width < 0.0 {
+            return Err(InputError::BadObstacleSize {
+                length: slot.length,
+                width: slot.width,
+            });
+        }
+        let centre = [slot.x, slot.y];
+        Ok(Some(match slot.kind {
+            ObstacleKind::StaticCircle => Self::Circle {
+                centre,
+                radius: 0.5 * slot.length.max(slot.width),
+            },
+            _ => {
+                if slot.width > slot.length {
+                    return Err(InputError::BadObstacleSize {
+                        length: slot.length,
+                        width: slot.width,
+                    });
+                }
+                if slot.speed < 0.0 {
+                    return Err(InputError::NegativeSpeed { speed: slot.speed });
+                }
+                Self::Vessel(Ellipse {
+                    centre,
+                    psi: slot.psi,
+                    speed: slot.speed,
+                    semi_major: 0.5 * slot.length,
+                    semi_minor: 0.5 * slot.width,
+                })
+            }
+        }))
+    }
+
     /// Its [`ObstacleKind`].
     #[must_use]
     pub fn kind(&self) -> ObstacleKind {
         match self {
-            Self::Circle { .. } => ObstacleKind::Circle,
-            Self::Vessel(_) => ObstacleKind::Vessel,
+            Self::Circle { .. } => ObstacleKind::StaticCircle,
+            Self::Vessel(_) => ObstacleKind::VesselEllipse,
         }
     }
 
@@ -259,7 +189,7 @@ impl Obstacle {
     }
 
     /// Eq. (9): `|P O_j|` for a circle, the focal sum `|P F_1| + |P F_2|` for a ship
-    /// (m). The unit of comparison with [`Obstacle::safe_distance_eq14`].
+    /// (m). The unit of comparison with [`ActiveObstacle::safe_distance_eq14`].
     #[must_use]
     pub fn distance_eq9(&self, point: [f64; 2]) -> f64 {
         match self {
@@ -281,7 +211,7 @@ impl Obstacle {
 
     /// Eq. (14): safe distance of an own vessel of length `own_length` (m) with
     /// buffer `d_s0` (m): `L + R_j + d_S0` for a circle, `2 (L + a_j + d_S0)` for a
-    /// ship, in the units of [`Obstacle::distance_eq9`].
+    /// ship, in the units of [`ActiveObstacle::distance_eq9`].
     #[must_use]
     pub fn safe_distance_eq14(&self, own_length: f64, d_s0: f64) -> f64 {
         match self {
@@ -290,7 +220,7 @@ impl Obstacle {
         }
     }
 
-    /// Eq. (14) in the units of [`Obstacle::range`]: `L + R_j + d_S0` or
+    /// Eq. (14) in the units of [`ActiveObstacle::range`]: `L + R_j + d_S0` or
     /// `L + a_j + d_S0` (m).
     #[must_use]
     pub fn safe_range(&self, own_length: f64, d_s0: f64) -> f64 {
@@ -361,10 +291,10 @@ mod tests {
         let p = [5.0, 1.0];
         let d = dist(p, e.centre);
         assert!((e.focal_sum(p) - 2.0 * d).abs() < 1e-12);
-        let o = Obstacle::Vessel(e);
+        let o = ActiveObstacle::Vessel(e);
         assert!((o.range(p) - d).abs() < 1e-12);
         // Eq. (14) then is twice the circle line with R = a.
-        let c = Obstacle::Circle {
+        let c = ActiveObstacle::Circle {
             centre: e.centre,
             radius: 0.5,
         };
@@ -377,12 +307,12 @@ mod tests {
 
     #[test]
     fn eq14_values() {
-        let c = Obstacle::Circle {
+        let c = ActiveObstacle::Circle {
             centre: [0.0, 0.0],
             radius: 0.5,
         };
         assert!((c.safe_distance_eq14(1.255, 0.25) - 2.005).abs() < 1e-12);
-        let v = Obstacle::Vessel(ship(1.48, 0.48, 0.0));
+        let v = ActiveObstacle::Vessel(ship(1.48, 0.48, 0.0));
         assert!((v.safe_distance_eq14(1.255, 0.25) - 4.49).abs() < 1e-12);
         assert!((v.safe_range(1.255, 0.25) - 2.245).abs() < 1e-12);
         // The eq. (14) level set is where the ship's CG is L + d_S0 beyond the bow:
@@ -391,58 +321,48 @@ mod tests {
     }
 
     #[test]
-    fn input_validation() {
-        let ok = ObstacleInput {
+    fn slot_validation() {
+        let ok = ObstacleSlot {
             x: 1.0,
             y: 2.0,
             psi: 0.0,
             speed: 0.07,
             length: 1.48,
             width: 0.48,
-            kind: 2,
+            kind: ObstacleKind::VesselEllipse,
         };
-        assert!(matches!(ok.obstacle(), Ok(Some(Obstacle::Vessel(_)))));
-        let none = ObstacleInput {
+        let check = |slot: ObstacleSlot| ActiveObstacle::from_slot(&slot);
+        assert!(matches!(check(ok), Ok(Some(ActiveObstacle::Vessel(_)))));
+        let none = ObstacleSlot {
             x: f64::NAN,
-            kind: 0,
+            kind: ObstacleKind::None,
             ..ok
         };
-        assert_eq!(none.obstacle(), Ok(None));
+        assert_eq!(check(none), Ok(None));
         assert!(matches!(
-            ObstacleInput { kind: 3, ..ok }.obstacle(),
-            Err(InputError::UnknownKind { code: 3 })
-        ));
-        assert!(matches!(
-            ObstacleInput {
+            check(ObstacleSlot {
                 y: f64::INFINITY,
                 ..ok
-            }
-            .obstacle(),
+            }),
             Err(InputError::NonFiniteObstacle { field: "y" })
         ));
-        assert!(ObstacleInput { width: 2.0, ..ok }.obstacle().is_err());
-        assert!(ObstacleInput { length: 0.0, ..ok }.obstacle().is_err());
-        assert!(ObstacleInput { speed: -0.1, ..ok }.obstacle().is_err());
+        assert!(check(ObstacleSlot { width: 2.0, ..ok }).is_err());
+        assert!(check(ObstacleSlot { length: 0.0, ..ok }).is_err());
+        assert!(check(ObstacleSlot { speed: -0.1, ..ok }).is_err());
         // A circle uses the larger of its two sizes as the diameter.
-        let circle = ObstacleInput {
-            kind: 1,
+        let circle = ObstacleSlot {
+            kind: ObstacleKind::StaticCircle,
             length: 1.0,
             width: 1.2,
             ..ok
         };
         assert_eq!(
-            circle.obstacle(),
-            Ok(Some(Obstacle::Circle {
+            check(circle),
+            Ok(Some(ActiveObstacle::Circle {
                 centre: [1.0, 2.0],
                 radius: 0.6
             }))
         );
-        for code in 0..3 {
-            assert_eq!(
-                ObstacleKind::from_code(code).map(ObstacleKind::code),
-                Ok(code)
-            );
-        }
     }
 
     proptest! {
@@ -485,7 +405,7 @@ mod tests {
             prop_assert!(s <= 2.0 * (d * d + c * c).sqrt() + 1e-9);
             // So the range-equivalent distance is never below the centre distance,
             // and exceeds it by at most c.
-            let r = Obstacle::Vessel(e).range(p);
+            let r = ActiveObstacle::Vessel(e).range(p);
             prop_assert!(r >= d - 1e-9 && r <= d + c + 1e-9);
         }
     }

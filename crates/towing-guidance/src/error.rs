@@ -43,12 +43,6 @@ pub enum ParamError {
 /// A per-sample input refused by [`crate::ReferenceSystem::update`].
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum InputError {
-    /// Obstacle kind code other than 0, 1, 2.
-    #[error("unknown obstacle kind code {code} (0 none, 1 circle, 2 vessel)")]
-    UnknownKind {
-        /// The code.
-        code: i32,
-    },
     /// An active obstacle has a non-finite field.
     #[error("obstacle field `{field}` is not finite")]
     NonFiniteObstacle {
@@ -74,7 +68,7 @@ pub enum InputError {
     TooManyObstacles {
         /// Slots given.
         count: usize,
-        /// [`crate::MAX_OBSTACLES`].
+        /// [`towing_model::MAX_OBSTACLES`].
         max: usize,
     },
     /// The tow's state has a non-finite value.

@@ -4,8 +4,9 @@
 //! 111917, section 3.1 (eq. (8)-(11), (14)), plus a COLREGS encounter classifier.
 //!
 //! - [`geometry`]: angle wrapping, relative bearing, CPA / TCPA.
-//! - [`distance`]: obstacles from the FMI inputs (kind 0 none, 1 static circle,
-//!   2 vessel ellipse), eq. (9) distances (circle: centre; ellipse: focal sum),
+//! - [`distance`]: the active obstacles ([`ActiveObstacle`]) of the obstacle slots the
+//!   controller reads ([`towing_model::ObstacleSlot`]: none, static circle, vessel
+//!   ellipse), eq. (9) distances (circle: centre; ellipse: focal sum),
 //!   eq. (14) safe distances, and the range-equivalent distance compared with
 //!   `d_D`.
 //! - [`waypoint`]: the route (Table 4: [`Route::paper`]) and the clockwise waypoint
@@ -26,11 +27,12 @@
 //! assumed value are in `docs/colregs.md`.
 //!
 //! ```
-//! use towing_guidance::{GuidanceParams, ObstacleInput, ReferenceSystem, Route, TowState};
+//! use towing_guidance::{GuidanceParams, ReferenceSystem, Route, TowState};
+//! use towing_model::{ObstacleSlot, MAX_OBSTACLES};
 //!
 //! let mut guidance = ReferenceSystem::new(Route::paper(), GuidanceParams::default());
 //! let tow = TowState::default(); // from the plant: ship pose and velocity, tug poses
-//! let obstacles = [ObstacleInput::default(); 8]; // FMI obstacle slots, kind 0 = empty
+//! let obstacles = [ObstacleSlot::EMPTY; MAX_OBSTACLES]; // the FMI obstacle slots, all empty
 //! let out = guidance.update(&tow, &obstacles)?;
 //! let [x_d, y_d, psi_d] = out.eta_sd.eta(); // reference for the controller
 //! assert_eq!((out.active_waypoint, out.altered), (1, false));
@@ -53,12 +55,12 @@ pub use colregs::{
     action, classify, role, Action, ColregsSettings, Encounter, EncounterThresholds, Manoeuvre,
     Role, Rule17Settings, Situation, ThresholdPreset, TowStatus,
 };
-pub use distance::{Ellipse, Obstacle, ObstacleInput, ObstacleKind};
+pub use distance::{ActiveObstacle, Ellipse};
 pub use error::{InputError, ParamError};
 pub use geometry::{body_to_ned, cpa, relative_bearing, wrap_angle, Cpa};
 pub use params::{GuidanceParams, GuidanceSettings, StaticHazardPolicy};
 pub use reference::{
     assess_obstacle, AssessContext, GuidanceOutput, ObstacleAssessment, ReferenceSystem, TowState,
-    TowVessel, MAX_OBSTACLES,
+    TowVessel,
 };
-pub use waypoint::{rotate_waypoint, theta_max, Pose, Route};
+pub use waypoint::{rotate_waypoint, theta_max, Route};

@@ -39,16 +39,18 @@
 
 use serde::{Deserialize, Serialize};
 
+use towing_model::{ObstacleKind, ObstacleSlot, Pose, MAX_OBSTACLES};
+
 use crate::colregs::{action, classify, Action, Encounter, Manoeuvre, Situation};
-use crate::distance::{Obstacle, ObstacleInput, ObstacleKind};
+use crate::distance::ActiveObstacle;
 use crate::error::InputError;
 use crate::geometry::{dist, segment_distance};
 use crate::params::{GuidanceParams, StaticHazardPolicy};
-use crate::waypoint::{rotate_waypoint, theta_max, Pose, Route};
+use crate::waypoint::{rotate_waypoint, theta_max, Route};
 
-/// Largest number of obstacle slots [`ReferenceSystem::update`] accepts (the
-/// encounters are tracked in a 64-bit mask, without allocation).
-pub const MAX_OBSTACLES: usize = 64;
+// [`ReferenceSystem::update`] accepts up to the interface's [`MAX_OBSTACLES`] slots and
+// tracks their encounters in 64-bit masks, without allocation.
+const _: () = assert!(MAX_OBSTACLES <= 64);
 
 /// State of the tow at a sample, as the controller sees it.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -159,7 +161,7 @@ pub fn assess_obstacle(
     params: &GuidanceParams,
     tow: &TowState,
     index: usize,
-    obstacle: &Obstacle,
+    obstacle: &ActiveObstacle,
     context: &AssessContext,
 ) -> ObstacleAssessment {
     let s = params.settings();
@@ -178,13 +180,13 @@ pub fn assess_obstacle(
         }
     }
     let (encounter, situation, policy, detection) = match obstacle {
-        Obstacle::Circle { .. } => (
+        ActiveObstacle::Circle { .. } => (
             None,
             None,
             Action::AlterToStarboard,
             s.static_detection_distance,
         ),
-        Obstacle::Vessel(target) => {
+        ActiveObstacle::Vessel(target) => {
             let enc = classify(
                 tow.ship,
                 tow.ship_vel_n,
@@ -203,9 +205,11 @@ pub fn assess_obstacle(
     };
     let detected = range <= detection;
     let alteration_allowed = match (obstacle, s.static_hazard_policy, context.leg) {
-        (Obstacle::Circle { centre, .. }, StaticHazardPolicy::WhenAlteringHelps, Some(leg)) => {
-            segment_distance(*centre, leg[0], leg[2]) > segment_distance(*centre, leg[0], leg[1])
-        }
+        (
+            ActiveObstacle::Circle { centre, .. },
+            StaticHazardPolicy::WhenAlteringHelps,
+            Some(leg),
+        ) => segment_distance(*centre, leg[0], leg[2]) > segment_distance(*centre, leg[0], leg[1]),
         _ => true,
     };
     let past_and_clear = encounter.is_some_and(|enc| {
@@ -248,9 +252,9 @@ fn past_and_clear(
     params: &GuidanceParams,
     tow: &TowState,
     vessels: &[(TowVessel, [f64; 2], f64); 3],
-    obstacle: &Obstacle,
+    obstacle: &ActiveObstacle,
 ) -> bool {
-    let Obstacle::Vessel(target) = obstacle else {
+    let ActiveObstacle::Vessel(target) = obstacle else {
         return false;
     };
     let s = params.settings();
@@ -296,7 +300,8 @@ pub struct GuidanceOutput {
 /// altered it. Allocation-free per sample.
 ///
 /// ```
-/// use towing_guidance::{GuidanceParams, ObstacleInput, Pose, ReferenceSystem, Route, TowState};
+/// use towing_guidance::{GuidanceParams, ReferenceSystem, Route, TowState};
+/// use towing_model::{ObstacleKind, ObstacleSlot, Pose};
 ///
 /// let mut guidance = ReferenceSystem::new(Route::paper(), GuidanceParams::default());
 /// let ship = Pose::from_deg(-4.9, 7.0, 101.3);
@@ -304,9 +309,9 @@ pub struct GuidanceOutput {
 /// let tow = TowState { ship, ship_vel_n: [-0.02, 0.098], tug1: ahead(-2.17), tug2: ahead(2.085) };
 /// // A target ship 5 m ahead of tug 2 on the reciprocal course: head-on.
 /// let target = ahead(7.085);
-/// let obstacles = [ObstacleInput {
+/// let obstacles = [ObstacleSlot {
 ///     x: target.x, y: target.y, psi: ship.psi + std::f64::consts::PI,
-///     speed: 0.07, length: 1.48, width: 0.48, kind: 2,
+///     speed: 0.07, length: 1.48, width: 0.48, kind: ObstacleKind::VesselEllipse,
 /// }];
 /// let out = guidance.update(&tow, &obstacles)?;
 /// assert!(out.altered);
@@ -420,16 +425,16 @@ impl ReferenceSystem {
     }
 
     /// One sample: assess the obstacles (slot `k` of `obstacles` is obstacle `k`;
-    /// kind 0 slots are ignored), update the encounter state and the active
+    /// [`ObstacleKind::None`] slots are ignored), update the encounter state and the active
     /// waypoint, and return the reference.
     ///
     /// # Errors
     /// A non-finite tow state, more than [`MAX_OBSTACLES`] slots, or an invalid
-    /// active obstacle ([`ObstacleInput::obstacle`]). The state is then unchanged.
+    /// active obstacle ([`ActiveObstacle::from_slot`]). The state is then unchanged.
     pub fn update(
         &mut self,
         tow: &TowState,
-        obstacles: &[ObstacleInput],
+        obstacles: &[ObstacleSlot],
     ) -> Result<GuidanceOutput, InputError> {
         tow.validate()?;
         if obstacles.len() > MAX_OBSTACLES {
@@ -453,12 +458,12 @@ impl ReferenceSystem {
             self.reference(self.active, true).0.position(),
         ];
         for (index, input) in obstacles.iter().enumerate() {
-            let Some(obstacle) = input.obstacle()? else {
+            let Some(obstacle) = ActiveObstacle::from_slot(input)? else {
                 continue;
             };
             let held_before = match obstacle {
-                Obstacle::Vessel(_) => self.held[index],
-                Obstacle::Circle { .. } => None,
+                ActiveObstacle::Vessel(_) => self.held[index],
+                ActiveObstacle::Circle { .. } => None,
             };
             let bit = 1u64 << index;
             let context = AssessContext {
@@ -473,7 +478,7 @@ impl ReferenceSystem {
                 nearest = Some(a);
             }
             let detection = match a.kind {
-                ObstacleKind::Circle => s.static_detection_distance,
+                ObstacleKind::StaticCircle => s.static_detection_distance,
                 _ => s.detection_distance,
             };
             let in_encounter = a.range <= detection + s.release_margin;
@@ -571,26 +576,26 @@ mod tests {
         )
     }
 
-    fn vessel(x: f64, y: f64, psi: f64, speed: f64) -> ObstacleInput {
-        ObstacleInput {
+    fn vessel(x: f64, y: f64, psi: f64, speed: f64) -> ObstacleSlot {
+        ObstacleSlot {
             x,
             y,
             psi,
             speed,
             length: 1.48,
             width: 0.48,
-            kind: 2,
+            kind: ObstacleKind::VesselEllipse,
         }
     }
 
-    fn circle(x: f64, y: f64, diameter: f64) -> ObstacleInput {
-        ObstacleInput {
+    fn circle(x: f64, y: f64, diameter: f64) -> ObstacleSlot {
+        ObstacleSlot {
             x,
             y,
             length: diameter,
             width: diameter,
-            kind: 1,
-            ..ObstacleInput::default()
+            kind: ObstacleKind::StaticCircle,
+            ..ObstacleSlot::default()
         }
     }
 
@@ -599,8 +604,8 @@ mod tests {
         Route::from_positions(&[[0.0, 0.0], [30.0, 0.0], [60.0, 0.0]]).unwrap()
     }
 
-    fn moved(o: ObstacleInput, dt: f64) -> ObstacleInput {
-        ObstacleInput {
+    fn moved(o: ObstacleSlot, dt: f64) -> ObstacleSlot {
+        ObstacleSlot {
             x: o.x + o.speed * dt * o.psi.cos(),
             y: o.y + o.speed * dt * o.psi.sin(),
             ..o
@@ -614,7 +619,7 @@ mod tests {
         let mut tow = tow_at(route.points()[0], 0.0);
         let mut visited = vec![1];
         for _ in 0..1000 {
-            let out = rs.update(&tow, &[ObstacleInput::default(); 8]).unwrap();
+            let out = rs.update(&tow, &[ObstacleSlot::default(); 8]).unwrap();
             assert!(!out.altered);
             assert_eq!(out.theta, 0.0);
             assert_eq!(out.d_ob, f64::INFINITY);
@@ -878,10 +883,10 @@ mod tests {
         .unwrap();
         for (pos, vessel_expected, d) in cases {
             let mut rs = ReferenceSystem::new(north_route(), by_distance);
-            let empty = ObstacleInput {
+            let empty = ObstacleSlot {
                 x: f64::NAN,
-                kind: 0,
-                ..ObstacleInput::default()
+                kind: ObstacleKind::None,
+                ..ObstacleSlot::default()
             };
             let far = circle(-50.0, -50.0, 1.0);
             let out = rs
@@ -902,10 +907,10 @@ mod tests {
             };
             assert!((g.safe_distance_eq14 - (length + 0.5 + 0.25)).abs() < 1e-12);
         }
-        // Only a kind-0 slot sitting on the ship: nothing.
+        // Only an empty slot sitting on the ship: nothing.
         let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
-        let ghost = ObstacleInput {
-            kind: 0,
+        let ghost = ObstacleSlot {
+            kind: ObstacleKind::None,
             ..circle(0.0, 0.0, 1.0)
         };
         let out = rs.update(&tow, &[ghost]).unwrap();
@@ -1037,13 +1042,14 @@ mod tests {
         let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
         let tow = tow_at(Pose::new(2.0, 0.0, 0.0), 0.1);
         assert!(rs.update(&tow, &[circle(2.0, -2.0, 1.0)]).unwrap().altered);
-        let bad = ObstacleInput {
-            kind: 7,
-            ..ObstacleInput::default()
+        let bad = ObstacleSlot {
+            x: f64::NAN,
+            kind: ObstacleKind::VesselEllipse,
+            ..ObstacleSlot::default()
         };
         assert_eq!(
             rs.update(&tow, &[bad]),
-            Err(InputError::UnknownKind { code: 7 })
+            Err(InputError::NonFiniteObstacle { field: "x" })
         );
         assert!(rs.is_altered());
         let mut nan_tow = tow;
@@ -1052,7 +1058,7 @@ mod tests {
             rs.update(&nan_tow, &[]),
             Err(InputError::NonFiniteTowState { field: "tug2.y" })
         ));
-        let many = [ObstacleInput::default(); MAX_OBSTACLES + 1];
+        let many = [ObstacleSlot::default(); MAX_OBSTACLES + 1];
         assert!(matches!(
             rs.update(&tow, &many),
             Err(InputError::TooManyObstacles { .. })

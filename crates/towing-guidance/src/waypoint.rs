@@ -12,59 +12,18 @@
 //! `chi = atan2(y_p - y_{p-1}, x_p - x_{p-1})` (the segment's course), and
 //! `psi_pN = psi_p + theta` (eq. (11)).
 
-use serde::{Deserialize, Serialize};
+use towing_model::Pose;
 
 use crate::error::ParamError;
 use crate::geometry::wrap_angle;
-
-/// A pose in NED: `x` North (m), `y` East (m), `psi` heading from North, clockwise
-/// (rad, `(-pi, pi]`). The paper's `eta = [x, y, psi]`.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-pub struct Pose {
-    /// North (m).
-    pub x: f64,
-    /// East (m).
-    pub y: f64,
-    /// Heading (rad).
-    pub psi: f64,
-}
-
-impl Pose {
-    /// A pose from metres and radians.
-    #[must_use]
-    pub const fn new(x: f64, y: f64, psi: f64) -> Self {
-        Self { x, y, psi }
-    }
-
-    /// A pose from metres and a heading in degrees (for tables such as Table 4).
-    #[must_use]
-    pub fn from_deg(x: f64, y: f64, psi_deg: f64) -> Self {
-        Self::new(x, y, wrap_angle(psi_deg.to_radians()))
-    }
-
-    /// Position `(x, y)` (m).
-    #[must_use]
-    pub fn position(&self) -> [f64; 2] {
-        [self.x, self.y]
-    }
-
-    /// `[x, y, psi]`, the paper's `eta`.
-    #[must_use]
-    pub fn eta(&self) -> [f64; 3] {
-        [self.x, self.y, self.psi]
-    }
-
-    fn is_finite(&self) -> bool {
-        self.x.is_finite() && self.y.is_finite() && self.psi.is_finite()
-    }
-}
 
 /// Eq. (10)-(11), consistent form: the waypoint `wp` rotated clockwise (to
 /// starboard) by `theta` (rad) about `prev`, keeping its distance to `prev`; its
 /// heading becomes `wp.psi + theta` (wrapped).
 ///
 /// ```
-/// use towing_guidance::{rotate_waypoint, Pose};
+/// use towing_guidance::rotate_waypoint;
+/// use towing_model::Pose;
 /// // A northbound segment of 10 m rotated by 90 deg points East.
 /// let w = rotate_waypoint(Pose::new(0.0, 0.0, 0.0), Pose::new(10.0, 0.0, 0.0), 90f64.to_radians());
 /// assert!(w.x.abs() < 1e-12 && (w.y - 10.0).abs() < 1e-12);

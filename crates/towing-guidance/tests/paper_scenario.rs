@@ -6,9 +6,9 @@
 #![allow(clippy::unwrap_used)]
 
 use towing_guidance::{
-    GuidanceOutput, GuidanceParams, ObstacleInput, ObstacleKind, Pose, ReferenceSystem, Route,
-    Situation, TowState,
+    GuidanceOutput, GuidanceParams, ReferenceSystem, Route, Situation, TowState,
 };
+use towing_model::{ObstacleKind, ObstacleSlot, Pose};
 
 /// Forward tug CG ahead of the ship CG: l_2 + l_tow2 + l_T2 (Table 2).
 const TUG2_AHEAD: f64 = 0.585 + 1.0 + 0.5;
@@ -31,25 +31,29 @@ fn tow_at(ship: Pose, speed: f64) -> TowState {
 /// heading North at 0.07 m/s from activation times 0, 405, 590 s: this kinematic test
 /// fixes the times the paper's encounter windows give (the plant's scenario activates B
 /// and C by range instead, `scenarios/paper.toml`).
-fn traffic(t: f64) -> [ObstacleInput; 6] {
-    let hazard = |x, y| ObstacleInput {
+fn traffic(t: f64) -> [ObstacleSlot; 6] {
+    let hazard = |x, y| ObstacleSlot {
         x,
         y,
         length: 1.0,
         width: 1.0,
-        kind: 1,
-        ..ObstacleInput::default()
+        kind: ObstacleKind::StaticCircle,
+        ..ObstacleSlot::default()
     };
     let target = |x0: f64, y: f64, t_a: f64| {
         let active = t >= t_a;
-        ObstacleInput {
+        ObstacleSlot {
             x: x0 + if active { 0.07 * (t - t_a) } else { 0.0 },
             y,
             psi: 0.0,
             speed: if active { 0.07 } else { 0.0 },
             length: 1.48,
             width: 0.48,
-            kind: i32::from(active) * 2,
+            kind: if active {
+                ObstacleKind::VesselEllipse
+            } else {
+                ObstacleKind::None
+            },
         }
     };
     [
@@ -66,7 +70,7 @@ fn run() -> (Vec<GuidanceOutput>, Vec<TowState>) {
     run_with(traffic)
 }
 
-fn run_with(traffic: impl Fn(f64) -> [ObstacleInput; 6]) -> (Vec<GuidanceOutput>, Vec<TowState>) {
+fn run_with(traffic: impl Fn(f64) -> [ObstacleSlot; 6]) -> (Vec<GuidanceOutput>, Vec<TowState>) {
     let route = Route::paper();
     let mut rs = ReferenceSystem::new(route.clone(), GuidanceParams::default());
     let mut tow = tow_at(route.points()[0], 0.0);
@@ -106,7 +110,7 @@ fn each_target_alters_the_route_to_starboard_once_with_the_papers_situation() {
         }
         let g = out.governing.unwrap();
         // Only target ships alter the route: the hazards beside it never do.
-        assert_eq!(g.kind, ObstacleKind::Vessel, "t = {t}: {g:?}");
+        assert_eq!(g.kind, ObstacleKind::VesselEllipse, "t = {t}: {g:?}");
         // The reference turned clockwise from the route's heading.
         let dpsi = towing_guidance::wrap_angle(out.eta_sd.psi - out.route_waypoint.psi);
         assert!((dpsi - 15f64.to_radians()).abs() < 1e-12, "t = {t}");
@@ -158,7 +162,7 @@ fn without_targets_the_hazards_beside_the_route_never_alter_it() {
     let hazards_only = |t: f64| {
         let mut obstacles = traffic(t);
         for o in &mut obstacles[3..] {
-            o.kind = 0;
+            o.kind = ObstacleKind::None;
         }
         obstacles
     };

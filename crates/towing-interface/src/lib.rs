@@ -3,8 +3,12 @@
 //! its name, value reference, unit, declared type and description, for both ends of the
 //! connection.
 //!
-//! * [`vr`]: the value references of the connected variables and of `scenario` and
-//!   `log_file`, equal in both FMUs.
+//! * [`codec`]: the value-reference codec: every variable of the contract as a typed
+//!   [`ContractVariable`] with `encode` and `decode`, the [`VariableTable`] through which
+//!   each FMU decodes its own variables, [`UnknownReference`], and the FMI code of an
+//!   obstacle slot's kind.
+//! * [`vr`]: the numbering of the contract's value references (equal in both FMUs), which
+//!   [`ContractVariable::encode`] follows.
 //! * [`variables`]: builders of those variables for one end of the connection
 //!   ([`Direction::Output`] in the FMU that computes them, [`Direction::Input`] in the one
 //!   that reads them), and the generic parameter/input/output builders.
@@ -12,6 +16,9 @@
 //!   ([`ModelInfo`]).
 //! * [`scenario`]: the `scenario` String parameter (a file path, or the bundled
 //!   `resources/paper.toml`).
+//! * [`session`]: the scenario and log life cycle both FMUs share ([`RunSession`]): the
+//!   `scenario` and `log_file` parameters, the scenario as loaded, the MCAP log opened with
+//!   the run description and finished at terminate or release.
 //! * [`model_description_main`]: the body of each FMU's model description binary (`plant_model_description`, `controller_model_description`).
 //! * `testing` (feature `testing`): in-process test helpers shared by the FMU crates.
 //!
@@ -21,7 +28,9 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod codec;
 pub mod scenario;
+pub mod session;
 pub mod types;
 pub mod variables;
 pub mod vr;
@@ -29,62 +38,50 @@ pub mod vr;
 #[cfg(feature = "testing")]
 pub mod testing;
 
+use codec::{ForceComponent, Towline, TowlineField, Tug, Vessel};
 use fmi2_slave::description::ModelDescription;
 use std::io::Write as _;
 use std::process::ExitCode;
 
+pub use codec::{ContractVariable, ModelVariable, UnknownReference, VariableTable};
 pub use scenario::{ScenarioFile, BUNDLED_SCENARIO};
+pub use session::{LogHeader, RunSession};
 pub use types::{ModelInfo, RealType};
 pub use variables::Direction;
 
-/// The vessels in value-reference order: name prefix and description.
+/// The vessels in value-reference order ([`codec::Vessel`]): name prefix and description.
 pub const VESSELS: [(&str, &str); 3] = [
-    ("ship", "ship (CyberShip II)"),
-    ("tug1", "aft tug (TitoNeri)"),
-    ("tug2", "forward tug (TitoNeri)"),
+    (Vessel::Ship.name(), "ship (CyberShip II)"),
+    (Vessel::Tug1.name(), "aft tug (TitoNeri)"),
+    (Vessel::Tug2.name(), "forward tug (TitoNeri)"),
 ];
 
 /// The command vector in the order masters and tests use it: tug1 surge force, sway force,
 /// yaw moment, tug2 the same, towline1 and towline2 tension commands.
-pub const COMMANDS: [u32; 8] = [
-    vr::tug_force(0, 0),
-    vr::tug_force(0, 1),
-    vr::tug_force(0, 2),
-    vr::tug_force(1, 0),
-    vr::tug_force(1, 1),
-    vr::tug_force(1, 2),
-    vr::tension_cmd(0),
-    vr::tension_cmd(1),
-];
+pub const COMMANDS: [u32; 8] = {
+    use ContractVariable::{TensionCmd, TugForce};
+    use ForceComponent::{Surge, Sway, Yaw};
+    [
+        TugForce(Tug::Tug1, Surge).encode(),
+        TugForce(Tug::Tug1, Sway).encode(),
+        TugForce(Tug::Tug1, Yaw).encode(),
+        TugForce(Tug::Tug2, Surge).encode(),
+        TugForce(Tug::Tug2, Sway).encode(),
+        TugForce(Tug::Tug2, Yaw).encode(),
+        TensionCmd(Towline::Towline1).encode(),
+        TensionCmd(Towline::Towline2).encode(),
+    ]
+};
 
-/// The names of DESIGN.md's interface contract every FMU declares: the commands, the vessel
-/// states, the towline values, the obstacle slots, `scenario` and `log_file`.
+/// The names of DESIGN.md's interface contract every FMU declares: the vessel states, the
+/// commands, the towline values, the obstacle slots, `scenario` and `log_file` (every
+/// [`ContractVariable`] but the plant's own `towlineN.slack`).
 #[must_use]
 pub fn contract_names() -> Vec<String> {
-    let mut names = vec![];
-    for tug in ["tug1", "tug2"] {
-        for f in ["force_surge", "force_sway", "moment_yaw"] {
-            names.push(format!("{tug}.{f}"));
-        }
-    }
-    for (vessel, _) in VESSELS {
-        for s in ["x", "y", "psi", "u", "v", "r"] {
-            names.push(format!("{vessel}.{s}"));
-        }
-    }
-    for line in ["towline1", "towline2"] {
-        for f in ["tension_cmd", "length", "angle", "tension"] {
-            names.push(format!("{line}.{f}"));
-        }
-    }
-    for k in 1..=towing_model::MAX_OBSTACLES {
-        for f in ["x", "y", "psi", "speed", "length", "width", "kind"] {
-            names.push(format!("obstacle[{k}].{f}"));
-        }
-    }
-    names.push("scenario".into());
-    names.push("log_file".into());
-    names
+    ContractVariable::all()
+        .filter(|v| !matches!(v, ContractVariable::Towline(_, TowlineField::Slack)))
+        .map(ContractVariable::name)
+        .collect()
 }
 
 /// The body of an FMU's model description binary: prints `description` as

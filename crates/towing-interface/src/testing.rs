@@ -4,9 +4,11 @@
 //! FMUs must pass.
 #![allow(clippy::missing_panics_doc, clippy::expect_used)]
 
+use crate::codec::{ModelVariable, VariableTable};
 use fmi2_slave::description::ModelDescription;
 use fmi2_slave::ffi::Fmi2Status;
 use fmi2_slave::testing::{Exports, Fmu};
+use fmi2_slave::{Fmi2Model, InstanceContext, Logger, ValueType};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -90,6 +92,116 @@ pub fn assert_contract_names_are_declared(description: &ModelDescription) {
     }
 }
 
+/// Every variable of `description` decodes through `table` to itself: a variable of its
+/// value reference and FMI type (a contract variable of its name), and the table holds no
+/// variable the description lacks.
+pub fn assert_every_variable_decodes_to_itself<V: ModelVariable>(
+    description: &ModelDescription,
+    table: &VariableTable<V>,
+) {
+    for var in &description.variables {
+        let (ty, vr) = (var.value_type(), var.value_reference);
+        let decoded = table
+            .decode(ty, vr)
+            .unwrap_or_else(|e| panic!("{}: {e}", var.name));
+        assert_eq!(decoded.value_reference(), vr, "{}", var.name);
+        assert_eq!(decoded.value_type(), ty, "{}", var.name);
+        if let Some(contract) = decoded.contract() {
+            assert_eq!(contract.name(), var.name);
+        }
+    }
+    let extra: Vec<V> = table
+        .variables()
+        .filter(|v| {
+            description
+                .find(v.value_type(), v.value_reference())
+                .is_none()
+        })
+        .collect();
+    assert!(extra.is_empty(), "not in the model description: {extra:?}");
+    assert_eq!(table.variables().count(), description.variables.len());
+}
+
+/// A value reference no variable of `description` has, of any type.
+fn unused_reference(description: &ModelDescription) -> u32 {
+    (900_000..)
+        .find(|&vr| {
+            description
+                .variables
+                .iter()
+                .all(|v| v.value_reference != vr)
+        })
+        .expect("a free value reference")
+}
+
+/// A value reference unknown to `description` is `fmi2Error` in the getter and the setter
+/// of every FMI type, the message naming the reference and the type (never `fmi2Fatal`).
+pub fn assert_unknown_references_are_errors(exports: Exports, description: &ModelDescription) {
+    let vr = unused_reference(description);
+    for ty in [
+        ValueType::Real,
+        ValueType::Integer,
+        ValueType::Boolean,
+        ValueType::String,
+    ] {
+        for set in [false, true] {
+            // In initialization mode, where getters and setters are both allowed.
+            let fmu = instantiate(exports, description, "unknown");
+            assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
+            assert_eq!(fmu.enter_init(), Fmi2Status::Ok, "{}", fmu.log_text());
+            let status = match (ty, set) {
+                (ValueType::Real, false) => fmu.try_get_real(vr).0,
+                (ValueType::Real, true) => fmu.set_real(vr, 1.0),
+                (ValueType::Integer, false) => fmu.try_get_integer(vr).0,
+                (ValueType::Integer, true) => fmu.set_integer(vr, 1),
+                (ValueType::Boolean, false) => fmu.try_get_boolean(vr).0,
+                (ValueType::Boolean, true) => fmu.set_boolean(vr, true),
+                (ValueType::String, false) => fmu.try_get_string(vr).0,
+                (ValueType::String, true) => fmu.set_string(vr, "x"),
+            };
+            assert_eq!(status, Fmi2Status::Error, "{ty:?} set {set}");
+            assert_last_message_contains(&fmu, &format!("unknown value reference {vr}"));
+            assert_last_message_contains(&fmu, ty.as_str());
+        }
+    }
+}
+
+/// The model's own getters and setters (called directly, past the layer's checks) refuse a
+/// value reference unknown to `description` of every FMI type with an error naming the
+/// reference, the type and the model: the FMU's variable table decodes it, nothing panics.
+pub fn assert_model_refuses_unknown_references<M: Fmi2Model>(description: &ModelDescription) {
+    let vr = unused_reference(description);
+    let logger = Logger::silent("unknown");
+    let ctx = InstanceContext {
+        instance_name: "unknown",
+        resource_dir: None,
+        logger: &logger,
+    };
+    let mut model = M::instantiate(&ctx).expect("instantiate");
+    let errors = [
+        (ValueType::Real, model.get_real(vr).err()),
+        (ValueType::Real, model.set_real(&logger, vr, 1.0).err()),
+        (ValueType::Integer, model.get_integer(vr).err()),
+        (ValueType::Integer, model.set_integer(&logger, vr, 1).err()),
+        (ValueType::Boolean, model.get_boolean(vr).err()),
+        (
+            ValueType::Boolean,
+            model.set_boolean(&logger, vr, true).err(),
+        ),
+        (ValueType::String, model.get_string(vr).err()),
+        (ValueType::String, model.set_string(&logger, vr, "x").err()),
+    ];
+    for (ty, error) in errors {
+        let e = error.unwrap_or_else(|| panic!("{ty:?} value reference {vr} was accepted"));
+        let expected = format!(
+            "unknown value reference {vr}: no {} variable of {} has it",
+            ty.as_str(),
+            description.model_identifier
+        );
+        assert_eq!(e, expected);
+    }
+}
+
 /// Without a resources folder and with an empty `scenario`, entering initialization is
 /// refused with a message saying to set `scenario`.
 pub fn assert_no_resources_and_no_scenario_is_refused(
@@ -115,11 +227,17 @@ pub fn assert_missing_scenario_file_is_named(exports: Exports, description: &Mod
 }
 
 /// The model-description tests of an FMU crate, on the `static` [`ModelDescription`]
-/// `$description`: consistent, equal to the committed `modelDescription/<id>.xml`, its
-/// variable table in docs/interface.md, and every contract name declared.
+/// `$description` and the FMU's [`VariableTable`] `$table`: consistent, equal to the
+/// committed `modelDescription/<id>.xml`, its variable table in docs/interface.md, every
+/// contract name declared, and every variable decoding to itself.
 #[macro_export]
 macro_rules! model_description_tests {
-    ($description:expr) => {
+    ($description:expr, $table:expr) => {
+        #[test]
+        fn every_variable_decodes_to_itself() {
+            $crate::testing::assert_every_variable_decodes_to_itself(&$description, &$table);
+        }
+
         #[test]
         fn description_is_consistent() {
             $crate::testing::assert_description_is_consistent(&$description);

@@ -7,11 +7,13 @@
 //! hold their start value 0 until its first step (`initial="exact"`). Every input starts at
 //! 0. The descriptions say what the variable means to the FMU that declares it.
 
+use crate::codec::{
+    ContractVariable, ForceComponent, ObstacleField, Slot, StateComponent, Towline, TowlineField,
+    Tug, Vessel,
+};
 use crate::types::{real_kind, OBSTACLE_KIND_TYPE};
-use crate::vr;
 use crate::VESSELS;
 use fmi2_slave::description::{Causality, Initial, Variability, Variable, VariableKind};
-use towing_model::MAX_OBSTACLES;
 
 /// Which end of a connection an FMU is for a group of variables.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -22,12 +24,10 @@ pub enum Direction {
     Input,
 }
 
-/// A connected Real field: name, unit, and its description in the FMU that outputs it and
-/// in the one that reads it.
+/// A connected Real field (its name is the codec's: [`ContractVariable::name`]): unit, and
+/// its description in the FMU that outputs it and in the one that reads it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Field {
-    /// Name (after the `vessel.`, `towlineN.` or `obstacle[k].` prefix).
-    pub name: &'static str,
     /// Unit (one of [`REAL_TYPES`](crate::types::REAL_TYPES)).
     pub unit: &'static str,
     /// Meaning where it is an output.
@@ -37,22 +37,16 @@ pub struct Field {
 }
 
 impl Field {
-    const fn new(
-        name: &'static str,
-        unit: &'static str,
-        output: &'static str,
-        input: &'static str,
-    ) -> Self {
+    const fn new(unit: &'static str, output: &'static str, input: &'static str) -> Self {
         Field {
-            name,
             unit,
             output,
             input,
         }
     }
 
-    const fn same(name: &'static str, unit: &'static str, meaning: &'static str) -> Self {
-        Field::new(name, unit, meaning, meaning)
+    const fn same(unit: &'static str, meaning: &'static str) -> Self {
+        Field::new(unit, meaning, meaning)
     }
 
     fn meaning(&self, direction: Direction) -> &'static str {
@@ -63,66 +57,57 @@ impl Field {
     }
 }
 
-/// A vessel's states x, y, psi, u, v, r (NED position, heading, body-frame velocities).
+/// A vessel's states x, y, psi, u, v, r (NED position, heading, body-frame velocities), by
+/// [`StateComponent::index`].
 pub const STATES: [Field; 6] = [
-    Field::same("x", "m", "North position of the body origin (NED)"),
-    Field::same("y", "m", "East position of the body origin (NED)"),
+    Field::same("m", "North position of the body origin (NED)"),
+    Field::same("m", "East position of the body origin (NED)"),
     Field::new(
-        "psi",
         "rad",
         "heading from North, clockwise positive, wrapped to (-pi, pi]",
         "heading from North, clockwise positive",
     ),
-    Field::same("u", "m/s", "surge velocity (body frame)"),
-    Field::same("v", "m/s", "sway velocity (body frame, starboard positive)"),
-    Field::same("r", "rad/s", "yaw rate (clockwise positive)"),
+    Field::same("m/s", "surge velocity (body frame)"),
+    Field::same("m/s", "sway velocity (body frame, starboard positive)"),
+    Field::same("rad/s", "yaw rate (clockwise positive)"),
 ];
 
-/// A tug's force commands (tug body frame).
+/// A tug's force commands (tug body frame), by [`ForceComponent::index`].
 pub const TUG_FORCES: [Field; 3] = [
-    Field::new(
-        "force_surge",
-        "N",
+    Field::new("N",
         "commanded thruster force along the tug's body x axis (MPC thrust plus the inner loop, within the thrust limits)",
         "thruster force along the tug's body x axis",
     ),
-    Field::new(
-        "force_sway",
-        "N",
+    Field::new("N",
         "commanded thruster force along the tug's body y axis (starboard; MPC thrust plus the inner loop, within the thrust limits)",
         "thruster force along the tug's body y axis (starboard)",
     ),
-    Field::new(
-        "moment_yaw",
-        "N.m",
+    Field::new("N.m",
         "commanded thruster moment about the tug's body z axis (clockwise positive; MPC thrust plus the inner loop, within the thrust limits)",
         "thruster moment about the tug's body z axis (clockwise positive)",
     ),
 ];
 
-/// Obstacle slot fields (Real ones; `kind` is the Integer field [`vr::OBSTACLE_KIND`]).
+/// Obstacle slot fields by [`ObstacleField::index`] (the Real ones; `kind` is the Integer
+/// [`ObstacleField::Kind`]).
 pub const OBSTACLE_FIELDS: [Field; 6] = [
-    Field::same("x", "m", "North position of the obstacle centre"),
-    Field::same("y", "m", "East position of the obstacle centre"),
+    Field::same("m", "North position of the obstacle centre"),
+    Field::same("m", "East position of the obstacle centre"),
     Field::new(
-        "psi",
         "rad",
         "course of a target ship (0 for static hazards)",
         "course of a target ship (ignored for static hazards)",
     ),
     Field::new(
-        "speed",
         "m/s",
         "speed of a target ship (0 for static hazards and before activation)",
         "speed of a target ship (ignored for static hazards)",
     ),
     Field::same(
-        "length",
         "m",
         "major axis of a target ship's ellipse; diameter of a static circle",
     ),
     Field::same(
-        "width",
         "m",
         "minor axis of a target ship's ellipse; diameter of a static circle",
     ),
@@ -170,12 +155,12 @@ pub fn parameter(name: &str, vr: u32, kind: VariableKind, description: &str) -> 
     }
 }
 
-/// The String parameter `scenario` ([`vr::SCENARIO`], start empty).
+/// The String parameter `scenario` ([`ContractVariable::Scenario`], start empty).
 #[must_use]
 pub fn scenario_parameter(description: &str) -> Variable {
     parameter(
-        "scenario",
-        vr::SCENARIO,
+        &ContractVariable::Scenario.name(),
+        ContractVariable::Scenario.encode(),
         VariableKind::String {
             start: Some(String::new()),
         },
@@ -183,13 +168,13 @@ pub fn scenario_parameter(description: &str) -> Variable {
     )
 }
 
-/// The String parameter `log_file` ([`vr::LOG_FILE`], start empty): the MCAP log of the
-/// unit (docs/logging.md), created when initialization ends; empty, no log.
+/// The String parameter `log_file` ([`ContractVariable::LogFile`], start empty): the MCAP
+/// log of the unit (docs/logging.md), created when initialization ends; empty, no log.
 #[must_use]
 pub fn log_file_parameter() -> Variable {
     parameter(
-        "log_file",
-        vr::LOG_FILE,
+        &ContractVariable::LogFile.name(),
+        ContractVariable::LogFile.encode(),
         VariableKind::String {
             start: Some(String::new()),
         },
@@ -232,34 +217,34 @@ pub fn calculated_output(
     }
 }
 
-/// A measurement (plant output, controller input) of `unit`.
+/// A measurement `var` (plant output, controller input) of `unit`.
 fn measurement(
     direction: Direction,
-    name: String,
-    vr: u32,
+    var: ContractVariable,
     unit: &str,
     description: String,
 ) -> Variable {
+    let (name, vr) = (var.name(), var.encode());
     match direction {
         Direction::Output => calculated_output(
             name,
             vr,
             real_kind(unit, None),
             description,
-            vec![vr::SCENARIO],
+            vec![ContractVariable::Scenario.encode()],
         ),
         Direction::Input => input(name, vr, real_kind(unit, Some(0.0)), description),
     }
 }
 
-/// A command (controller output, plant input) of `unit`, start 0.
+/// A command `var` (controller output, plant input) of `unit`, start 0.
 fn command(
     direction: Direction,
-    name: String,
-    vr: u32,
+    var: ContractVariable,
     unit: &str,
     description: String,
 ) -> Variable {
+    let (name, vr) = (var.name(), var.encode());
     let kind = real_kind(unit, Some(0.0));
     match direction {
         Direction::Output => exact_output(name, vr, kind, description),
@@ -272,24 +257,23 @@ fn command(
 #[must_use]
 pub fn commands(direction: Direction) -> Vec<Variable> {
     let mut v = Vec::new();
-    for tug in 0..2u32 {
-        let (name, what) = VESSELS[tug as usize + 1];
-        for (c, field) in TUG_FORCES.iter().enumerate() {
+    for tug in Tug::ALL {
+        let (_, what) = VESSELS[tug.vessel().index()];
+        for c in ForceComponent::ALL {
+            let field = &TUG_FORCES[c.index()];
             v.push(command(
                 direction,
-                format!("{name}.{}", field.name),
-                vr::tug_force(tug, c as u32),
+                ContractVariable::TugForce(tug, c),
                 field.unit,
                 format!("{what} {}", field.meaning(direction)),
             ));
         }
     }
-    for line in 0..2u32 {
-        let n = line + 1;
+    for line in Towline::ALL {
+        let n = line.index() + 1;
         v.push(command(
             direction,
-            format!("towline{n}.tension_cmd"),
-            vr::tension_cmd(line),
+            ContractVariable::TensionCmd(line),
             "N",
             match direction {
                 Direction::Output => format!(
@@ -308,13 +292,14 @@ pub fn commands(direction: Direction) -> Vec<Variable> {
 #[must_use]
 pub fn vessel_states(direction: Direction) -> Vec<Variable> {
     let mut v = Vec::new();
-    for (i, (vessel, what)) in VESSELS.iter().enumerate() {
-        for (c, field) in STATES.iter().enumerate() {
+    for vessel in Vessel::ALL {
+        let (_, what) = VESSELS[vessel.index()];
+        for c in StateComponent::ALL {
+            let field = &STATES[c.index()];
             let meaning = field.meaning(direction);
             v.push(measurement(
                 direction,
-                format!("{vessel}.{}", field.name),
-                vr::vessel_state(i as u32, c as u32),
+                ContractVariable::VesselState(vessel, c),
                 field.unit,
                 match direction {
                     Direction::Output => format!("{what}: {meaning}"),
@@ -326,30 +311,32 @@ pub fn vessel_states(direction: Direction) -> Vec<Variable> {
     v
 }
 
-/// `towlineN.length`, `.angle`, `.tension` of line 0 (towline1) or 1 (towline2).
+/// `towlineN.length`, `.angle`, `.tension` of `line` (the plant adds the Boolean `slack`).
 #[must_use]
-pub fn towline(line: u32, direction: Direction) -> Vec<Variable> {
-    let n = line + 1;
-    let ends = if line == 0 {
-        "ship stern point to the aft tug's bow point"
-    } else {
-        "ship bow point to the forward tug's stern point"
+pub fn towline(line: Towline, direction: Direction) -> Vec<Variable> {
+    let n = line.index() + 1;
+    let ends = match line {
+        Towline::Towline1 => "ship stern point to the aft tug's bow point",
+        Towline::Towline2 => "ship bow point to the forward tug's stern point",
     };
-    // Name, unit, meaning to the controller (which reads them but does not use them).
+    // Field, unit, meaning to the controller (which reads them but does not use them).
     let fields = [
-        ("length", "m", "distance between the attachment points"),
-        ("angle", "rad", "measured towing angle alpha"),
-        ("tension", "N", "measured tension"),
+        (
+            TowlineField::Length,
+            "m",
+            "distance between the attachment points",
+        ),
+        (TowlineField::Angle, "rad", "measured towing angle alpha"),
+        (TowlineField::Tension, "N", "measured tension"),
     ];
     let mut v: Vec<Variable> = fields
         .iter()
-        .enumerate()
-        .map(|(f, &(name, unit, input_meaning))| {
-            let description = match (direction, f) {
-                (Direction::Output, 0) => {
+        .map(|&(field, unit, input_meaning)| {
+            let description = match (direction, field) {
+                (Direction::Output, TowlineField::Length) => {
                     format!("distance between the towline {n} attachment points ({ends})")
                 }
-                (Direction::Output, 1) => format!(
+                (Direction::Output, TowlineField::Angle) => format!(
                     "towing angle alpha_{n} (Du et al. 2022, eq. (4)-(6), consistent form of docs/interface.md): towline direction relative to the ship heading"
                 ),
                 (Direction::Output, _) => format!(
@@ -361,8 +348,7 @@ pub fn towline(line: u32, direction: Direction) -> Vec<Variable> {
             };
             measurement(
                 direction,
-                format!("towline{n}.{name}"),
-                vr::towline(line, f as u32),
+                ContractVariable::Towline(line, field),
                 unit,
                 description,
             )
@@ -380,19 +366,19 @@ pub fn towline(line: u32, direction: Direction) -> Vec<Variable> {
 #[must_use]
 pub fn obstacles(direction: Direction) -> Vec<Variable> {
     let mut v = Vec::new();
-    for slot in 0..MAX_OBSTACLES as u32 {
-        let k = slot + 1;
-        for (j, field) in OBSTACLE_FIELDS.iter().enumerate() {
+    for slot in Slot::all() {
+        let k = slot.index() + 1;
+        // The Real fields; `kind`, the last, follows.
+        for (field, meaning) in ObstacleField::ALL.iter().zip(&OBSTACLE_FIELDS) {
             v.push(measurement(
                 direction,
-                format!("obstacle[{k}].{}", field.name),
-                vr::obstacle(slot, j as u32),
-                field.unit,
-                format!("obstacle slot {k}: {}", field.meaning(direction)),
+                ContractVariable::Obstacle(slot, *field),
+                meaning.unit,
+                format!("obstacle slot {k}: {}", meaning.meaning(direction)),
             ));
         }
-        let name = format!("obstacle[{k}].kind");
-        let kind_vr = vr::obstacle(slot, vr::OBSTACLE_KIND);
+        let kind_var = ContractVariable::Obstacle(slot, ObstacleField::Kind);
+        let (name, kind_vr) = (kind_var.name(), kind_var.encode());
         let kind = |start| VariableKind::Integer {
             declared_type: Some(OBSTACLE_KIND_TYPE.to_owned()),
             start,
@@ -405,7 +391,7 @@ pub fn obstacles(direction: Direction) -> Vec<Variable> {
                 kind_vr,
                 kind(None),
                 format!("obstacle slot {k}: 0 none (empty slot or target ship not yet active), 1 static circle, 2 vessel ellipse"),
-                vec![vr::SCENARIO],
+                vec![ContractVariable::Scenario.encode()],
             ),
             Direction::Input => input(
                 name,
@@ -432,8 +418,8 @@ mod tests {
         let groups: [fn(Direction) -> Vec<Variable>; 5] = [
             commands,
             vessel_states,
-            |d| towline(0, d),
-            |d| towline(1, d),
+            |d| towline(Towline::Towline1, d),
+            |d| towline(Towline::Towline2, d),
             obstacles,
         ];
         for group in groups {
@@ -456,8 +442,8 @@ mod tests {
         for d in [Direction::Output, Direction::Input] {
             all.extend(commands(d));
             all.extend(vessel_states(d));
-            all.extend(towline(0, d));
-            all.extend(towline(1, d));
+            all.extend(towline(Towline::Towline1, d));
+            all.extend(towline(Towline::Towline2, d));
             all.extend(obstacles(d));
         }
         all.push(scenario_parameter("scenario"));

@@ -1,5 +1,8 @@
-//! Value references of the connected variables, the same in both FMUs (unique per FMI base
-//! type):
+//! The numbering of the contract's value references, the same in both FMUs and unique
+//! across the FMI base types (so [`ContractVariable::decode`](crate::ContractVariable::decode)
+//! needs no type). [`ContractVariable::encode`](crate::ContractVariable::encode) follows it;
+//! the FMUs decode through [`crate::codec`], never with these numbers. The functions here
+//! take 0-based indices (tests and masters use them to address a variable):
 //!
 //! | range | what |
 //! |---|---|
@@ -39,8 +42,9 @@ pub const fn towline(line: u32, field: u32) -> u32 {
     300 + 10 * line + field
 }
 
-/// Obstacle slot value, `slot` 0-based; field index into
-/// [`OBSTACLE_FIELDS`](crate::variables::OBSTACLE_FIELDS), or [`OBSTACLE_KIND`].
+/// Obstacle slot value, `slot` 0-based; field index of
+/// [`ObstacleField`](crate::codec::ObstacleField) (x, y, psi, speed, length, width, then
+/// [`OBSTACLE_KIND`]).
 pub const fn obstacle(slot: u32, field: u32) -> u32 {
     1000 + 10 * slot + field
 }

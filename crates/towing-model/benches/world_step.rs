@@ -5,7 +5,9 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use towing_model::{HullModel, Scenario, World, WorldConfig, WorldInputs, MAX_OBSTACLES};
+use towing_model::{
+    HullModel, ObstacleKind, Scenario, World, WorldConfig, WorldInputs, MAX_OBSTACLES,
+};
 
 const SCENARIO: &str = include_str!("eight_obstacles.toml");
 
@@ -38,7 +40,7 @@ fn world_step(c: &mut Criterion) {
         ..WorldConfig::default()
     };
     let mut world = World::new(&scenario, config).expect("bench world builds");
-    assert!((0..MAX_OBSTACLES).all(|k| world.obstacle(k).kind != 0));
+    assert!((0..MAX_OBSTACLES).all(|k| world.obstacle(k).kind != ObstacleKind::None));
     let inputs = inputs(2022, 1024);
     let mut k = 0;
     c.bench_function("world_step_0.1s_nonlinear_8_obstacles", |b| {

@@ -13,7 +13,12 @@
 //!   ([`VesselData::cybership2`], [`VesselData::titoneri`]).
 //! - [`towline`]: the two towlines, forces from geometry (tension along the line,
 //!   moment `r x F`), ideal winch or elastic line ([`TowlineModel`]).
-//! - [`traffic`]: static hazards and target ships, moved analytically.
+//! - [`traffic`]: static hazards and target ships ([`TrafficObstacle`]), moved
+//!   analytically, and what an obstacle slot shows at a time ([`ObstacleSlot`], its
+//!   [`ObstacleKind`]).
+//! - [`state`]: a pose ([`Pose`]) and a vessel's pose and velocity ([`VesselState`]);
+//!   [`config`]: the physics configuration ([`WorldConfig`]). The scenario and the world
+//!   both use them; the world reads the scenario, never the other way round.
 //! - [`world`]: the three vessels and two towlines integrated jointly with RK4
 //!   ([`World`]), atomic steps, state serialisation.
 //! - [`scenario`]: the TOML scenario format ([`Scenario`], `docs/scenario-format.md`);
@@ -43,7 +48,7 @@
 //! assert!(world.ship().nu[0] > 0.0); // the ship is under way
 //! assert_eq!(world.towline(1).tension, 2.0);
 //! let target_a = world.obstacle(3); // at world.time()
-//! assert_eq!(target_a.kind, 2);
+//! assert_eq!(target_a.kind, towing_model::ObstacleKind::VesselEllipse);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 #![forbid(unsafe_code)]
@@ -51,22 +56,24 @@
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
 pub mod angle;
+pub mod config;
 pub mod kinetics;
 pub mod scenario;
+pub mod state;
 pub mod towline;
 pub mod traffic;
 pub mod vessel;
 pub mod world;
 
 pub use angle::wrap_angle;
+pub use config::WorldConfig;
 pub use kinetics::{HullDynamics, HullModel, LinearDampingHull, NonlinearDampingHull};
-pub use scenario::{
-    Pose, Route, Scenario, ScenarioError, ScenarioErrorKind, TugPlacement, Waterway,
-};
+pub use scenario::{Route, Scenario, ScenarioError, ScenarioErrorKind, TugPlacement, Waterway};
+pub use state::{Pose, VesselState};
 pub use towline::{ElasticTowlineParams, TowlineModel, TowlineOutput};
-pub use traffic::{Obstacle, ObstacleOutput, ObstacleShape};
+pub use traffic::{ObstacleKind, ObstacleShape, ObstacleSlot, TrafficObstacle};
 pub use vessel::{Damping, ParamError, TitoNeriDampingSet, VesselData};
-pub use world::{StepError, VesselState, World, WorldConfig, WorldError, WorldInputs};
+pub use world::{StepError, World, WorldError, WorldInputs};
 
 /// Number of obstacle output slots of the world (and of the plant FMU's
 /// `obstacle[k].*` outputs, k = 1..8). A scenario with more obstacles is refused.

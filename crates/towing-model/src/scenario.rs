@@ -16,13 +16,15 @@ use serde::Deserialize;
 use toml::de::{DeTable, DeValue};
 
 use crate::angle::wrap_angle;
+use crate::config::WorldConfig;
 use crate::kinetics::HullModel;
+pub use crate::state::Pose;
+use crate::state::VesselState;
 use crate::towline::{formation_pose, ElasticTowlineParams, TowlineModel};
-use crate::traffic::{Obstacle, ObstacleShape};
+use crate::traffic::{ObstacleShape, TrafficObstacle};
 use crate::vessel::{
     check_finite, check_positive, Damping, ParamError, TitoNeriDampingSet, VesselData,
 };
-use crate::world::{VesselState, WorldConfig};
 use crate::MAX_OBSTACLES;
 
 /// The scenario format version this build reads.
@@ -100,17 +102,6 @@ impl fmt::Display for ScenarioError {
 
 impl std::error::Error for ScenarioError {}
 
-/// A pose on the route: `x` North (m), `y` East (m), `psi` heading (rad).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Pose {
-    /// North (m).
-    pub x: f64,
-    /// East (m).
-    pub y: f64,
-    /// Heading (rad, `(-pi, pi]`).
-    pub psi: f64,
-}
-
 /// The planned route (Du et al. 2022, Table 4): origin, waypoints, destination.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Route {
@@ -187,7 +178,7 @@ pub struct Scenario {
     /// The waterway, if given.
     pub waterway: Option<Waterway>,
     /// Static hazards and target ships (at most [`MAX_OBSTACLES`]).
-    pub obstacles: Vec<Obstacle>,
+    pub obstacles: Vec<TrafficObstacle>,
     /// Ship parameters (CyberShip II preset with the file's overrides).
     pub ship_data: VesselData,
     /// Tug parameters (TitoNeri preset with the file's overrides).
@@ -869,7 +860,7 @@ fn convert(file: FileScenario, origin: &str) -> Result<Scenario, ScenarioError> 
                 activation_range: o.activation_range,
             },
         };
-        obstacles.push(Obstacle {
+        obstacles.push(TrafficObstacle {
             name: o.name,
             x: o.x,
             y: o.y,

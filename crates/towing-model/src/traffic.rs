@@ -5,23 +5,34 @@
 //! Motion is exact and analytic: a target ship at `(x0, y0)` with course `chi`
 //! and speed `U`, activated at `t_a`, is at `(x0, y0) + U (t - t_a) (cos chi, sin chi)`
 //! for `t >= t_a`. Before `t_a` it does not exist: it reports its spawn position
-//! and size with kind 0 and speed 0 (see `paper/NOTES.md` section 2 for why the
+//! and size with kind [`ObstacleKind::None`] and speed 0 (see `paper/NOTES.md` section 2 for why the
 //! paper's targets B and C need a late activation).
 //!
 //! A target is activated by time (`activation_time`, known in advance) or by
 //! range (`activation_range`: the ship came that close to the spawn position),
 //! whichever comes first. Range activation depends on the run, so its time is
-//! dynamic state kept by [`crate::World`]; [`Obstacle::output_activated`] takes the
-//! effective activation time, [`Obstacle::output_at`] uses the time trigger only.
+//! dynamic state kept by [`crate::World`]; [`TrafficObstacle::output_activated`] takes the
+//! effective activation time, [`TrafficObstacle::output_at`] uses the time trigger only.
+
+use serde::{Deserialize, Serialize};
 
 use crate::vessel::ParamError;
 
-/// `ObstacleOutput::kind` of an empty slot or an inactive target ship.
-pub const KIND_NONE: i32 = 0;
-/// `ObstacleOutput::kind` of a static circle.
-pub const KIND_CIRCLE: i32 = 1;
-/// `ObstacleOutput::kind` of a target ship (ellipse).
-pub const KIND_VESSEL: i32 = 2;
+/// What occupies an obstacle slot ([`ObstacleSlot::kind`]): the FMI Integer
+/// `obstacle[k].kind` (0, 1, 2 in docs/interface.md) is this enum's code, converted only
+/// by the value-reference codec of `towing-interface`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+pub enum ObstacleKind {
+    /// An empty slot, or a target ship not yet active; its other fields are not read.
+    #[default]
+    None,
+    /// A static hazard, a circle of diameter `length` = `width` (Du et al. 2022,
+    /// eq. (9), first line).
+    StaticCircle,
+    /// A target ship, an ellipse with major axis `length` and minor axis `width` along
+    /// its course `psi`, moving at `speed` (eq. (9), focal sum).
+    VesselEllipse,
+}
 
 /// Shape and motion of an obstacle.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,9 +63,11 @@ pub enum ObstacleShape {
     },
 }
 
-/// One obstacle of a scenario.
+/// One obstacle of a scenario's traffic (its `[[obstacles]]` entry): a static hazard or a
+/// target ship, with its name, spawn position and motion. What it shows at a time `t` is
+/// an [`ObstacleSlot`].
 #[derive(Debug, Clone, PartialEq)]
-pub struct Obstacle {
+pub struct TrafficObstacle {
     /// Name (unique within a scenario), e.g. `"A"`.
     pub name: String,
     /// Spawn position North (m).
@@ -65,9 +78,11 @@ pub struct Obstacle {
     pub shape: ObstacleShape,
 }
 
-/// What the plant reports about one obstacle slot at a time `t`.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ObstacleOutput {
+/// One obstacle slot at a time `t` (`obstacle[k].*` of docs/interface.md): what the plant
+/// outputs about the `k`-th obstacle of the scenario and what the controller reads. The
+/// one type on both ends of the connection.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct ObstacleSlot {
     /// Centre North (m).
     pub x: f64,
     /// Centre East (m).
@@ -80,24 +95,24 @@ pub struct ObstacleOutput {
     pub length: f64,
     /// Width (m): ellipse minor axis, or the circle's diameter.
     pub width: f64,
-    /// [`KIND_NONE`] (empty slot or inactive), [`KIND_CIRCLE`] or [`KIND_VESSEL`].
-    pub kind: i32,
+    /// What occupies the slot.
+    pub kind: ObstacleKind,
 }
 
-impl ObstacleOutput {
-    /// An empty slot: all zero, kind 0.
-    pub const EMPTY: ObstacleOutput = ObstacleOutput {
+impl ObstacleSlot {
+    /// An empty slot: all zero, [`ObstacleKind::None`].
+    pub const EMPTY: ObstacleSlot = ObstacleSlot {
         x: 0.0,
         y: 0.0,
         psi: 0.0,
         speed: 0.0,
         length: 0.0,
         width: 0.0,
-        kind: KIND_NONE,
+        kind: ObstacleKind::None,
     };
 }
 
-impl Obstacle {
+impl TrafficObstacle {
     /// True when the obstacle exists at time `t` by the time trigger alone
     /// (static: always; ship: `t >= activation_time`). Range activation is not
     /// known here; see [`crate::World::activation_time`].
@@ -138,7 +153,7 @@ impl Obstacle {
     /// State at time `t` (s), exact, with the time trigger only (as if the range
     /// trigger never fired).
     #[must_use]
-    pub fn output_at(&self, t: f64) -> ObstacleOutput {
+    pub fn output_at(&self, t: f64) -> ObstacleSlot {
         let by_time = self.activation_time().filter(|&t_a| t >= t_a);
         self.output_activated(t, by_time)
     }
@@ -149,16 +164,16 @@ impl Obstacle {
     /// `(x, y) + speed (t - t_a) (cos, sin)(course)`. Static obstacles ignore
     /// `activated_at`.
     #[must_use]
-    pub fn output_activated(&self, t: f64, activated_at: Option<f64>) -> ObstacleOutput {
+    pub fn output_activated(&self, t: f64, activated_at: Option<f64>) -> ObstacleSlot {
         match self.shape {
-            ObstacleShape::Circle { diameter } => ObstacleOutput {
+            ObstacleShape::Circle { diameter } => ObstacleSlot {
                 x: self.x,
                 y: self.y,
                 psi: 0.0,
                 speed: 0.0,
                 length: diameter,
                 width: diameter,
-                kind: KIND_CIRCLE,
+                kind: ObstacleKind::StaticCircle,
             },
             ObstacleShape::Vessel {
                 length,
@@ -170,24 +185,24 @@ impl Obstacle {
                 if let Some(t_a) = activated_at.filter(|&t_a| t >= t_a) {
                     let run = speed * (t - t_a);
                     let (s, c) = course.sin_cos();
-                    ObstacleOutput {
+                    ObstacleSlot {
                         x: self.x + run * c,
                         y: self.y + run * s,
                         psi: course,
                         speed,
                         length,
                         width,
-                        kind: KIND_VESSEL,
+                        kind: ObstacleKind::VesselEllipse,
                     }
                 } else {
-                    ObstacleOutput {
+                    ObstacleSlot {
                         x: self.x,
                         y: self.y,
                         psi: course,
                         speed: 0.0,
                         length,
                         width,
-                        kind: KIND_NONE,
+                        kind: ObstacleKind::None,
                     }
                 }
             }
@@ -244,8 +259,8 @@ impl Obstacle {
 mod tests {
     use super::*;
 
-    fn target(activation_time: f64) -> Obstacle {
-        Obstacle {
+    fn target(activation_time: f64) -> TrafficObstacle {
+        TrafficObstacle {
             name: "B".into(),
             x: -22.0,
             y: 40.75,
@@ -260,7 +275,7 @@ mod tests {
         }
     }
 
-    fn set_triggers(o: &mut Obstacle, time: f64, range: Option<f64>) {
+    fn set_triggers(o: &mut TrafficObstacle, time: f64, range: Option<f64>) {
         if let ObstacleShape::Vessel {
             activation_time,
             activation_range,
@@ -278,15 +293,18 @@ mod tests {
         // world says it was activated.
         let mut b = target(0.0);
         set_triggers(&mut b, f64::INFINITY, Some(14.0));
-        assert_eq!(b.output_at(1e6).kind, KIND_NONE);
+        assert_eq!(b.output_at(1e6).kind, ObstacleKind::None);
         assert!(!b.is_active(1e6));
-        assert_eq!(b.output_activated(500.0, None).kind, KIND_NONE);
+        assert_eq!(b.output_activated(500.0, None).kind, ObstacleKind::None);
         // Not yet at 399 s when activated at 400 s.
-        assert_eq!(b.output_activated(399.0, Some(400.0)).kind, KIND_NONE);
+        assert_eq!(
+            b.output_activated(399.0, Some(400.0)).kind,
+            ObstacleKind::None
+        );
         let at = b.output_activated(400.0, Some(400.0));
         assert_eq!(
             (at.kind, at.x, at.y, at.speed),
-            (KIND_VESSEL, -22.0, 40.75, 0.07)
+            (ObstacleKind::VesselEllipse, -22.0, 40.75, 0.07)
         );
         let later = b.output_activated(500.0, Some(400.0));
         assert!((later.x - (-22.0 + 7.0)).abs() < 1e-12);
@@ -327,11 +345,11 @@ mod tests {
     fn target_ship_is_inactive_before_activation_and_moves_exactly_after() {
         let b = target(405.0);
         let before = b.output_at(404.9);
-        assert_eq!(before.kind, KIND_NONE);
+        assert_eq!(before.kind, ObstacleKind::None);
         assert_eq!((before.x, before.y, before.speed), (-22.0, 40.75, 0.0));
         assert_eq!((before.length, before.width), (1.48, 0.48));
         let at = b.output_at(405.0);
-        assert_eq!(at.kind, KIND_VESSEL);
+        assert_eq!(at.kind, ObstacleKind::VesselEllipse);
         assert_eq!((at.x, at.y), (-22.0, 40.75));
         let later = b.output_at(505.0);
         assert!((later.x - (-22.0 + 7.0)).abs() < 1e-12);
@@ -353,7 +371,7 @@ mod tests {
 
     #[test]
     fn static_circle_reports_its_diameter() {
-        let a = Obstacle {
+        let a = TrafficObstacle {
             name: "a".into(),
             x: -10.0,
             y: 15.0,
@@ -362,14 +380,14 @@ mod tests {
         let out = a.output_at(1234.0);
         assert_eq!(
             out,
-            ObstacleOutput {
+            ObstacleSlot {
                 x: -10.0,
                 y: 15.0,
                 psi: 0.0,
                 speed: 0.0,
                 length: 1.0,
                 width: 1.0,
-                kind: KIND_CIRCLE
+                kind: ObstacleKind::StaticCircle
             }
         );
     }

@@ -46,77 +46,19 @@ use crate::kinetics::{HullDynamics, HullModel};
 use crate::scenario::{Scenario, ScenarioError};
 use crate::towline::{
     self, clamp_command, elastic_params, elastic_tension, geometry_kin, ideal_winch_tension,
-    loads_kin, winch_rate, ElasticTowlineParams, Kin, TowlineModel, TowlineOutput,
+    loads_kin, winch_rate, ElasticTowlineParams, Kin, TowlineOutput,
 };
-use crate::traffic::{Obstacle, ObstacleOutput, ObstacleShape};
-use crate::vessel::{check_positive, ParamError, VesselData};
+use crate::traffic::{ObstacleShape, ObstacleSlot, TrafficObstacle};
+use crate::vessel::{ParamError, VesselData};
 use crate::MAX_OBSTACLES;
+
+pub use crate::config::WorldConfig;
+pub use crate::state::VesselState;
 
 /// Largest number of RK4 substeps in one [`World::step`]; a larger `h /
 /// integration_step` is refused as [`StepError::InvalidStep`] (at the default
 /// 0.01 s this allows steps up to 10 000 s).
 pub const MAX_SUBSTEPS: u64 = 1_000_000;
-
-/// Configuration of the world's physics (not part of the dynamic state).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct WorldConfig {
-    /// Damping model of the hulls that [`World::new`] builds. With
-    /// [`World::with_hulls`] the hulls are given and this is only a label that
-    /// enters the state fingerprint.
-    pub hull_model: HullModel,
-    /// Towline model.
-    pub towline_model: TowlineModel,
-    /// Largest RK4 substep (s); see the module docs for the default 0.01 s.
-    pub integration_step: f64,
-}
-
-impl Default for WorldConfig {
-    /// Nonlinear hull damping, ideal winch, 0.01 s integration step.
-    fn default() -> Self {
-        WorldConfig {
-            hull_model: HullModel::NonlinearDamping,
-            towline_model: TowlineModel::IdealWinch,
-            integration_step: 0.01,
-        }
-    }
-}
-
-impl WorldConfig {
-    /// Upper bound of `integration_step` (s).
-    pub const MAX_INTEGRATION_STEP: f64 = 0.1;
-
-    /// Checks the configuration: `0 < integration_step <= 0.1 s`, towline
-    /// constants valid ([`TowlineModel::validate`]). Field paths are those of the
-    /// scenario file's `[simulation]` section.
-    pub fn validate(&self) -> Result<(), ParamError> {
-        check_positive("integration_step", self.integration_step, "s")?;
-        if self.integration_step > Self::MAX_INTEGRATION_STEP {
-            return Err(ParamError::new(
-                "integration_step",
-                format!(
-                    "must be at most {} s (RK4 accuracy for the tug and towline time scales), got {} s",
-                    Self::MAX_INTEGRATION_STEP,
-                    self.integration_step
-                ),
-            ));
-        }
-        self.towline_model
-            .validate()
-            .map_err(|e| e.within("elastic_towline"))
-    }
-}
-
-/// Pose and velocity of one vessel: `eta = [x North (m), y East (m), psi (rad,
-/// (-pi, pi])]`, `nu = [u (m/s), v (m/s), r (rad/s)]` in the body frame. Plain
-/// arrays so users need no linear-algebra crate; `nalgebra::Vector3::from(eta)`
-/// converts.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct VesselState {
-    /// `[x, y, psi]`, NED position (m) and heading (rad).
-    pub eta: [f64; 3],
-    /// `[u, v, r]`, body velocities (m/s, m/s, rad/s).
-    pub nu: [f64; 3],
-}
 
 /// Inputs held constant over one step.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -206,7 +148,7 @@ pub struct World {
     points: [[f64; 2]; 2],
     winch_max: [f64; 2],
     tau_max: [[f64; 3]; 2],
-    obstacles: Vec<Obstacle>,
+    obstacles: Vec<TrafficObstacle>,
     fingerprint: u64,
     // Dynamic state.
     time: f64,
@@ -358,7 +300,7 @@ impl World {
         let by_time = self
             .obstacles
             .get(slot)
-            .and_then(Obstacle::activation_time)
+            .and_then(TrafficObstacle::activation_time)
             .filter(|&t_a| self.time >= t_a);
         match (by_time, self.activated_at[slot]) {
             (Some(a), Some(b)) => Some(a.min(b)),
@@ -432,7 +374,7 @@ impl World {
 
     /// The obstacles of the scenario (at most [`MAX_OBSTACLES`]).
     #[must_use]
-    pub fn obstacles(&self) -> &[Obstacle] {
+    pub fn obstacles(&self) -> &[TrafficObstacle] {
         &self.obstacles
     }
 
@@ -480,17 +422,17 @@ impl World {
 
     /// Obstacle slot `slot` (0..[`MAX_OBSTACLES`]) at [`World::time`], with the
     /// effective activation ([`World::activation_time`]); slots beyond the
-    /// scenario's obstacles are [`ObstacleOutput::EMPTY`].
+    /// scenario's obstacles are [`ObstacleSlot::EMPTY`].
     ///
     /// # Panics
     /// If `slot >= MAX_OBSTACLES`.
     #[must_use]
-    pub fn obstacle(&self, slot: usize) -> ObstacleOutput {
+    pub fn obstacle(&self, slot: usize) -> ObstacleSlot {
         assert!(
             slot < MAX_OBSTACLES,
             "obstacle slot {slot} out of range (0..{MAX_OBSTACLES})"
         );
-        self.obstacles.get(slot).map_or(ObstacleOutput::EMPTY, |o| {
+        self.obstacles.get(slot).map_or(ObstacleSlot::EMPTY, |o| {
             o.output_activated(self.time, self.activation_time(slot))
         })
     }

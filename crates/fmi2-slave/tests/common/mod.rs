@@ -36,6 +36,8 @@ pub const FAULT_WARNING: i32 = 1;
 pub const FAULT_DISCARD: i32 = 2;
 pub const FAULT_ERROR: i32 = 3;
 pub const FAULT_PANIC: i32 = 4;
+/// Fault mode whose getter of `steps` refuses (a model error of a getter).
+pub const FAULT_GET: i32 = 5;
 
 pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(|| {
     let mut log_categories = LogCategory::standard();
@@ -135,6 +137,11 @@ pub static BROKEN_DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(|| {
     md
 });
 
+/// The model's refusal of a value reference it does not decode.
+fn unknown(ty: &str, vr: u32) -> String {
+    format!("unknown value reference {vr}: no {ty} variable of Lag has it")
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct LagModel<const BROKEN: bool> {
     u: f64,
@@ -190,15 +197,15 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
         Ok(())
     }
 
-    fn get_real(&self, vr: u32) -> f64 {
-        match vr {
+    fn get_real(&self, vr: u32) -> Result<f64, String> {
+        Ok(match vr {
             R_U => self.u,
             R_Y => self.y,
             R_T => self.t_const,
             R_Y0 => self.y0,
             R_RATE => 1.0 / self.t_const,
-            _ => unreachable!("layer checked vr {vr}"),
-        }
+            _ => return Err(unknown("Real", vr)),
+        })
     }
 
     fn set_real(&mut self, _log: &Logger, vr: u32, value: f64) -> Result<(), String> {
@@ -212,14 +219,17 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
         Ok(())
     }
 
-    fn get_integer(&self, vr: u32) -> i32 {
-        match vr {
+    fn get_integer(&self, vr: u32) -> Result<i32, String> {
+        Ok(match vr {
             I_SUBSTEPS => self.substeps,
+            I_STEPS if self.fault_mode == FAULT_GET => {
+                return Err(format!("refused by fault_mode {FAULT_GET}"))
+            }
             I_STEPS => self.steps,
             I_FAULT => self.fault_mode,
             I_VERSION => 7,
-            _ => unreachable!(),
-        }
+            _ => return Err(unknown("Integer", vr)),
+        })
     }
 
     fn set_integer(&mut self, _log: &Logger, vr: u32, value: i32) -> Result<(), String> {
@@ -232,11 +242,11 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
         Ok(())
     }
 
-    fn get_boolean(&self, vr: u32) -> bool {
+    fn get_boolean(&self, vr: u32) -> Result<bool, String> {
         match vr {
-            B_ENABLED => self.enabled,
-            B_PANIC_NOW => false,
-            _ => unreachable!(),
+            B_ENABLED => Ok(self.enabled),
+            B_PANIC_NOW => Ok(false),
+            _ => Err(unknown("Boolean", vr)),
         }
     }
 
@@ -250,9 +260,11 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
         Ok(())
     }
 
-    fn get_string(&self, vr: u32) -> String {
-        assert_eq!(vr, S_LABEL);
-        self.label.clone()
+    fn get_string(&self, vr: u32) -> Result<String, String> {
+        match vr {
+            S_LABEL => Ok(self.label.clone()),
+            _ => Err(unknown("String", vr)),
+        }
     }
 
     fn set_string(&mut self, _log: &Logger, vr: u32, value: &str) -> Result<(), String> {

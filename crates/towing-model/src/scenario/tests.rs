@@ -1,6 +1,6 @@
 use super::*;
 use crate::towline::{attachment_point, towing_angle};
-use crate::traffic::KIND_VESSEL;
+use crate::traffic::ObstacleKind;
 
 const ORIGIN: &str = "scenarios/test.toml";
 
@@ -126,7 +126,7 @@ fn paper_scenario_parses() {
     );
     // Activated at 405 s (by range, in a world), B moves North from its spawn.
     let b = s.obstacles[4].output_activated(405.0 + 100.0, Some(405.0));
-    assert_eq!(b.kind, KIND_VESSEL);
+    assert_eq!(b.kind, ObstacleKind::VesselEllipse);
     assert!((b.x - (-22.0 + 7.0)).abs() < 1e-12 && (b.y - 40.75).abs() < 1e-12);
     // The ship at the route origin, at rest.
     assert_eq!(s.ship.eta[..2], [-4.9, 7.0]);

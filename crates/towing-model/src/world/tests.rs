@@ -1,6 +1,7 @@
 use super::*;
 use crate::kinetics::NonlinearDampingHull;
-use crate::traffic::{KIND_CIRCLE, KIND_NONE, KIND_VESSEL};
+use crate::towline::TowlineModel;
+use crate::traffic::ObstacleKind;
 use nalgebra::Vector3;
 use proptest::prelude::*;
 use std::f64::consts::PI;
@@ -121,17 +122,20 @@ fn builds_from_the_paper_scenario_and_reports_obstacles() {
         assert!((out.length - 1.0).abs() < 1e-12);
         assert!(out.angle.abs() < 1e-12);
     }
-    assert_eq!(w.obstacle(0).kind, KIND_CIRCLE);
+    assert_eq!(w.obstacle(0).kind, ObstacleKind::StaticCircle);
     let a = w.obstacle(3);
     assert_eq!(
         (a.kind, a.x, a.y, a.speed),
-        (KIND_VESSEL, -19.0, 21.0, 0.07)
+        (ObstacleKind::VesselEllipse, -19.0, 21.0, 0.07)
     );
     let b = w.obstacle(4);
-    assert_eq!((b.kind, b.x, b.y, b.speed), (KIND_NONE, -22.0, 40.75, 0.0));
+    assert_eq!(
+        (b.kind, b.x, b.y, b.speed),
+        (ObstacleKind::None, -22.0, 40.75, 0.0)
+    );
     assert_eq!((b.length, b.width), (1.48, 0.48));
-    assert_eq!(w.obstacle(6), ObstacleOutput::EMPTY);
-    assert_eq!(w.obstacle(7), ObstacleOutput::EMPTY);
+    assert_eq!(w.obstacle(6), ObstacleSlot::EMPTY);
+    assert_eq!(w.obstacle(7), ObstacleSlot::EMPTY);
 }
 
 #[test]
@@ -152,12 +156,12 @@ activation_time = 1.0
 "#
     );
     let mut w = world_with(&text, WorldConfig::default());
-    assert_eq!(w.obstacle(0).kind, KIND_NONE);
+    assert_eq!(w.obstacle(0).kind, ObstacleKind::None);
     for _ in 0..30 {
         w.step(&WorldInputs::default(), 0.1).unwrap();
     }
     let o = w.obstacle(0);
-    assert_eq!(o.kind, KIND_VESSEL);
+    assert_eq!(o.kind, ObstacleKind::VesselEllipse);
     assert!((o.y - (5.0 + 0.1 * (w.time() - 1.0))).abs() < 1e-12);
     assert!((o.x - 5.0).abs() < 1e-12);
 }
@@ -630,7 +634,7 @@ fn bench_scenario_has_eight_active_obstacles() {
     let w = World::new(&s, s.world_config).unwrap();
     assert_eq!(w.obstacles().len(), MAX_OBSTACLES);
     for slot in 0..MAX_OBSTACLES {
-        assert_ne!(w.obstacle(slot).kind, KIND_NONE, "slot {slot}");
+        assert_ne!(w.obstacle(slot).kind, ObstacleKind::None, "slot {slot}");
     }
     assert_eq!(w.config().hull_model, HullModel::NonlinearDamping);
 }
@@ -1030,7 +1034,7 @@ fn range_target_activates_at_the_first_step_end_within_range_and_not_before() {
     let text = with_targets(&[(sx, sy, "activation_range = 3.2")]);
     let mut w = world_with(&text, WorldConfig::default());
     assert!(ship_distance_to(&w, sx, sy) > range);
-    assert_eq!(w.obstacle(0).kind, KIND_NONE);
+    assert_eq!(w.obstacle(0).kind, ObstacleKind::None);
     let mut steps = 0;
     loop {
         w.step(&PULL, 0.1).unwrap();
@@ -1040,13 +1044,19 @@ fn range_target_activates_at_the_first_step_end_within_range_and_not_before() {
         if d > range {
             // Not before: outside the range, nothing.
             assert_eq!(w.activation_time(0), None, "step {steps}, d = {d}");
-            assert_eq!((o.kind, o.x, o.y, o.speed), (KIND_NONE, sx, sy, 0.0));
+            assert_eq!(
+                (o.kind, o.x, o.y, o.speed),
+                (ObstacleKind::None, sx, sy, 0.0)
+            );
             assert!(steps < 200, "never came within range");
             continue;
         }
         // The first step end within range: active now, at the spawn position.
         assert_eq!(w.activation_time(0), Some(w.time()));
-        assert_eq!((o.kind, o.x, o.y, o.speed), (KIND_VESSEL, sx, sy, 0.1));
+        assert_eq!(
+            (o.kind, o.x, o.y, o.speed),
+            (ObstacleKind::VesselEllipse, sx, sy, 0.1)
+        );
         break;
     }
     assert!((20..100).contains(&steps), "{steps}");
@@ -1059,7 +1069,7 @@ fn range_target_activates_at_the_first_step_end_within_range_and_not_before() {
     assert!(ship_distance_to(&w, sx, sy) > range);
     let o = w.obstacle(0);
     assert_eq!(w.activation_time(0), Some(t_a));
-    assert_eq!(o.kind, KIND_VESSEL);
+    assert_eq!(o.kind, ObstacleKind::VesselEllipse);
     assert!((o.y - (sy + 0.1 * (w.time() - t_a))).abs() < 1e-12);
     assert_eq!(o.x, sx);
 }
@@ -1069,7 +1079,7 @@ fn range_target_within_range_at_the_start_is_active_from_t_0() {
     let text = with_targets(&[(1.0, 1.0, "activation_range = 2.0")]);
     let w = world_with(&text, WorldConfig::default());
     assert_eq!(w.activation_time(0), Some(0.0));
-    assert_eq!(w.obstacle(0).kind, KIND_VESSEL);
+    assert_eq!(w.obstacle(0).kind, ObstacleKind::VesselEllipse);
 }
 
 #[test]
@@ -1080,7 +1090,7 @@ fn range_target_far_away_never_activates() {
         w.step(&PULL, 0.1).unwrap();
     }
     assert_eq!(w.activation_time(0), None);
-    assert_eq!(w.obstacle(0).kind, KIND_NONE);
+    assert_eq!(w.obstacle(0).kind, ObstacleKind::None);
 }
 
 #[test]
@@ -1172,7 +1182,7 @@ fn activation_survives_write_and_read_state() {
     c.read_state(&before).unwrap();
     assert_eq!(
         (c.activation_time(0), c.obstacle(0).kind),
-        (None, KIND_NONE)
+        (None, ObstacleKind::None)
     );
 }
 
@@ -1252,10 +1262,10 @@ fn paper_targets_b_and_c_wait_for_the_tow() {
     let s = Scenario::paper().unwrap();
     let mut w = World::new(&s, WorldConfig::default()).unwrap();
     w.step(&WorldInputs::default(), 700.0).unwrap();
-    assert_eq!(w.obstacle(3).kind, KIND_VESSEL);
+    assert_eq!(w.obstacle(3).kind, ObstacleKind::VesselEllipse);
     assert_eq!(
         (w.obstacle(4).kind, w.obstacle(5).kind),
-        (KIND_NONE, KIND_NONE)
+        (ObstacleKind::None, ObstacleKind::None)
     );
     // Put the ship where the paper's tow was at 405 s (kinematic estimate, see
     // scenarios/paper.toml): B appears at the next step end, C does not.
