@@ -28,7 +28,7 @@ Usage (from the repository root, with the project's .venv):
 
     .venv/bin/python masters/closed_loop.py                       # paper scenario, 1200 s
     .venv/bin/python masters/closed_loop.py --architecture 2 --scheme 3 --out out/central-3
-    .venv/bin/python masters/closed_loop.py --stop-time 60 --param rho=2.0 --quiet
+    .venv/bin/python masters/closed_loop.py --stop-time 60 --param admm.rho=2.0 --quiet
 
 Options:
     --plant FMU, --controller FMU   default target/fmu/TowingPlant.fmu, TowingController.fmu
@@ -39,7 +39,7 @@ Options:
     --scheme {1,2,3}                avoidance scheme I, II, III of Du et al. (2022)
     --param NAME=VALUE              any controller parameter, typed from its
                                     modelDescription (repeatable)
-    --plant-param NAME=VALUE        the same for the plant (e.g. hull_model=1)
+    --plant-param NAME=VALUE        the same for the plant (e.g. model.hull_from_scenario=false)
     --coupling {gauss-seidel,jacobi}  order of a communication step (default gauss-seidel)
     --log-dir DIR                   MCAP logs (docs/logging.md): sets `log_file` to
                                     DIR/plant.mcap and DIR/controller.mcap (created)
@@ -667,7 +667,7 @@ def build_parser():
     p.add_argument("--architecture", type=int, choices=(1, 2), help="controller `architecture`: 1 distributed (ADMM), 2 centralized (default: the FMU's start value)")
     p.add_argument("--scheme", type=int, choices=(1, 2, 3), help="controller `avoidance_scheme`: scheme I, II or III of Du et al. (2022) (default: the FMU's start value)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", default=[], help="set any controller parameter, typed from its modelDescription (repeatable)")
-    p.add_argument("--plant-param", action="append", metavar="NAME=VALUE", default=[], help="set a plant parameter, e.g. hull_model=1 (repeatable)")
+    p.add_argument("--plant-param", action="append", metavar="NAME=VALUE", default=[], help="set a plant parameter, e.g. model.hull=1 (repeatable)")
     p.add_argument(
         "--coupling",
         choices=("gauss-seidel", "jacobi"),

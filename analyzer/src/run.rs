@@ -489,21 +489,30 @@ fn run_config(
     params: Option<&serde_json::Value>,
     controller: &ControllerData,
 ) -> RunConfig {
-    let param = |name: &str| -> Option<f64> {
-        let v = params?.get(name)?;
-        v.as_f64().or_else(|| v.as_str()?.trim().parse().ok())
+    // A parameter by its registry name (docs/interface.md), else by the name it had
+    // before the registry (logs of earlier versions); Booleans read as 0 / 1.
+    let param = |name: &str, old: &str| -> Option<f64> {
+        let p = params?;
+        let v = p.get(name).or_else(|| p.get(old))?;
+        v.as_f64()
+            .or_else(|| v.as_bool().map(f64::from))
+            .or_else(|| v.as_str()?.trim().parse().ok())
     };
     let defaults = Bounds::default();
     let bounds = Bounds {
         min_tension_n: 0.0,
-        max_tension_n: param("max_tension").unwrap_or(defaults.max_tension_n),
-        tension_rate_n_per_s: param("tension_rate").unwrap_or(defaults.tension_rate_n_per_s),
-        max_towing_angle_rad: param("max_towing_angle").unwrap_or(defaults.max_towing_angle_rad),
-        angle_rate_rad_per_s: param("angle_rate").unwrap_or(defaults.angle_rate_rad_per_s),
+        max_tension_n: param("mpc.ship.max_tension", "max_tension")
+            .unwrap_or(defaults.max_tension_n),
+        tension_rate_n_per_s: param("mpc.ship.tension_rate", "tension_rate")
+            .unwrap_or(defaults.tension_rate_n_per_s),
+        max_towing_angle_rad: param("mpc.ship.max_towing_angle", "max_towing_angle")
+            .unwrap_or(defaults.max_towing_angle_rad),
+        angle_rate_rad_per_s: param("mpc.ship.towing_angle_rate", "angle_rate")
+            .unwrap_or(defaults.angle_rate_rad_per_s),
         max_thrust: [
-            param("max_thrust_surge").unwrap_or(defaults.max_thrust[0]),
-            param("max_thrust_sway").unwrap_or(defaults.max_thrust[1]),
-            param("max_yaw_moment").unwrap_or(defaults.max_thrust[2]),
+            param("mpc.tug.max_force_surge", "max_thrust_surge").unwrap_or(defaults.max_thrust[0]),
+            param("mpc.tug.max_force_sway", "max_thrust_sway").unwrap_or(defaults.max_thrust[1]),
+            param("mpc.tug.max_moment_yaw", "max_yaw_moment").unwrap_or(defaults.max_thrust[2]),
         ],
     };
     let solver = &controller.solver;
@@ -511,13 +520,13 @@ fn run_config(
         .architecture
         .last()
         .copied()
-        .or_else(|| param("architecture").map(|v| v as i32));
+        .or_else(|| param("architecture", "architecture").map(|v| v as i32));
     let scheme = solver
         .scheme
         .last()
         .copied()
-        .or_else(|| param("avoidance_scheme").map(|v| v as i32));
-    let sample_time_s = param("sample_time")
+        .or_else(|| param("avoidance_scheme", "avoidance_scheme").map(|v| v as i32));
+    let sample_time_s = param("mpc.sample_time", "sample_time")
         .or_else(|| median_step_s(&controller.solver.t_ns))
         .unwrap_or(1.0);
 
@@ -531,15 +540,19 @@ fn run_config(
         towline_desired_length: scenario.towline_desired_length,
         destination: pose(&scenario.route.destination),
         route: scenario.route.points().map(pose).collect(),
-        detection_distance_m: param("detection_distance").unwrap_or(7.0),
-        safety_buffer_m: param("safety_buffer").unwrap_or(0.25),
+        detection_distance_m: param("guidance.detection_distance", "detection_distance")
+            .unwrap_or(7.0),
+        safety_buffer_m: param("guidance.safety_buffer", "safety_buffer").unwrap_or(0.25),
         sample_time_s,
         bounds,
         architecture,
         scheme,
-        waterway_half_width: param("waterway_half_width")
-            .filter(|w| *w > 0.0)
-            .or_else(|| scenario.waterway.as_ref().map(|w| w.half_width)),
+        waterway_half_width: if param("waterway.from_scenario", "").is_some_and(|v| v == 0.0) {
+            param("waterway.half_width", "")
+        } else {
+            param("", "waterway_half_width").filter(|w| *w > 0.0)
+        }
+        .or_else(|| scenario.waterway.as_ref().map(|w| w.half_width)),
     };
     config
 }

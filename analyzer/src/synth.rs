@@ -299,16 +299,16 @@ impl SynthRun {
         let params = serde_json::json!({
             "architecture": self.architecture,
             "avoidance_scheme": self.scheme,
-            "sample_time": self.dt * self.steps_per_sample as f64,
-            "max_tension": 3.0,
-            "tension_rate": 0.3,
-            "max_towing_angle": 30f64.to_radians(),
-            "angle_rate": 5f64.to_radians(),
-            "max_thrust_surge": 10.0,
-            "max_thrust_sway": 10.0,
-            "max_yaw_moment": 10.0,
-            "detection_distance": 7.0,
-            "safety_buffer": 0.25,
+            "mpc.sample_time": self.dt * self.steps_per_sample as f64,
+            "mpc.ship.max_tension": 3.0,
+            "mpc.ship.tension_rate": 0.3,
+            "mpc.ship.max_towing_angle": 30f64.to_radians(),
+            "mpc.ship.towing_angle_rate": 5f64.to_radians(),
+            "mpc.tug.max_force_surge": 10.0,
+            "mpc.tug.max_force_sway": 10.0,
+            "mpc.tug.max_moment_yaw": 10.0,
+            "guidance.detection_distance": 7.0,
+            "guidance.safety_buffer": 0.25,
         });
         for (w, unit) in [(plant, "TowingPlant"), (ctrl, "TowingController")] {
             w.write_run(&RunInfo {

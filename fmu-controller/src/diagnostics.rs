@@ -17,6 +17,7 @@ use fmi2_slave::ValueType;
 use std::fmt;
 use std::sync::LazyLock;
 use towing_control::{Command, SampleReport};
+use towing_guidance::{Role, Situation};
 use towing_interface::types::real_kind;
 use towing_interface::variables::exact_output;
 use towing_interface::VESSELS;
@@ -41,6 +42,8 @@ pub const COMPUTE_TIME: u32 = 3010;
 pub const FALLBACKS: u32 = 3011;
 /// `controller.samples` (Integer output).
 pub const SAMPLES: u32 = 3012;
+/// `mpc.budget_hit` (Boolean output).
+pub const BUDGET_HIT: u32 = 3013;
 /// `reference.x`, `.y`, `.psi` (Real outputs), component 0..3.
 pub const fn reference(component: u32) -> u32 {
     3020 + component
@@ -79,6 +82,7 @@ pub struct Outputs {
     pub(crate) command: Command,
     pub(crate) iterations: i32,
     pub(crate) converged: bool,
+    pub(crate) budget_hit: bool,
     pub(crate) r_pri: [f64; 2],
     pub(crate) r_dual: [f64; 2],
     pub(crate) compute_time: f64,
@@ -101,6 +105,7 @@ impl Default for Outputs {
             command: Command::default(),
             iterations: 0,
             converged: false,
+            budget_hit: false,
             r_pri: [0.0; 2],
             r_dual: [0.0; 2],
             compute_time: 0.0,
@@ -127,6 +132,7 @@ impl Outputs {
     pub(crate) fn record(&mut self, r: &SampleReport) {
         self.iterations = saturating_i32(r.iterations);
         self.converged = r.converged;
+        self.budget_hit = r.budget_hit;
         self.r_pri = r.r_pri;
         self.r_dual = r.r_dual;
         self.compute_time = r.compute_time;
@@ -141,8 +147,8 @@ impl Outputs {
             NO_OBSTACLE_DISTANCE
         };
         self.angle_desired = r.desired_angle;
-        self.situation = r.situation;
-        self.role = r.role;
+        self.situation = r.situation.map(situation_code);
+        self.role = r.role.map(role_code);
         for h in 0..HORIZON {
             let states = [
                 &r.prediction.ship[h],
@@ -153,6 +159,22 @@ impl Outputs {
                 self.prediction[h][vessel] = [s[0], s[1]];
             }
         }
+    }
+}
+
+/// The FMI code of a COLREGS situation (`-1`: none, static hazard or empty slot).
+#[must_use]
+pub fn situation_code(s: Option<Situation>) -> i32 {
+    s.map_or(-1, Situation::code)
+}
+
+/// The FMI code of the tow's role: 0 none, 1 give-way, 2 stand-on.
+#[must_use]
+pub fn role_code(r: Option<Role>) -> i32 {
+    match r {
+        None => 0,
+        Some(Role::GiveWay) => 1,
+        Some(Role::StandOn) => 2,
     }
 }
 
@@ -351,6 +373,12 @@ fn solver() -> Vec<Diagnostic> {
             move |o| o.r_dual[i],
         ));
     }
+    v.push(Diagnostic::boolean(
+        "mpc.budget_hit".into(),
+        BUDGET_HIT,
+        "true when the last sample's optimisation was stopped by its time budget (mpc.sample_time_budget): the best iterate within every bound so far was applied".into(),
+        |o| o.budget_hit,
+    ));
     v.push(Diagnostic::real(
         "controller.compute_time".into(),
         COMPUTE_TIME,
@@ -518,7 +546,7 @@ mod tests {
         }
         assert_eq!(
             DIAGNOSTICS.len(),
-            2 + 4 + 3 + 3 + 3 + 2 + 2 * MAX_OBSTACLES + 6 * HORIZON
+            2 + 4 + 4 + 3 + 3 + 2 + 2 * MAX_OBSTACLES + 6 * HORIZON
         );
     }
 }

@@ -3,6 +3,7 @@
 //! sample into a [`Sample`], and the log's writer thread builds, serializes and
 //! compresses them.
 
+use crate::diagnostics::{role_code, situation_code};
 use towing_control::{Measurement, SampleReport};
 use towing_log::scene::{self, colors};
 use towing_log::topics::{
@@ -86,12 +87,15 @@ pub fn write_sample(w: &mut LogWriter, s: &Sample) -> Result<(), LogError> {
     )?;
     let targets = (0..MAX_OBSTACLES)
         .filter(|&k| s.measurement.obstacles[k].kind != ObstacleKind::None)
-        .map(|k| Encounter {
-            slot: k as u32 + 1,
-            situation: situation_name(r.situation[k]).to_owned(),
-            role: role_name(r.role[k]).to_owned(),
-            situation_code: r.situation[k],
-            role_code: r.role[k],
+        .map(|k| {
+            let (situation, role) = (situation_code(r.situation[k]), role_code(r.role[k]));
+            Encounter {
+                slot: k as u32 + 1,
+                situation: situation_name(situation).to_owned(),
+                role: role_name(role).to_owned(),
+                situation_code: situation,
+                role_code: role,
+            }
         })
         .collect();
     w.write(names::CONTROLLER_COLREGS, t, &Colregs { t, targets })?;

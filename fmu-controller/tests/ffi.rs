@@ -100,8 +100,8 @@ fn outputs_hold_their_start_values_until_the_first_step() {
         }
         checked += 1;
     }
-    // 8 commands, 17 diagnostics, 8 x 2 COLREGS, 3 x 3 x 2 predictions.
-    assert_eq!(checked, 8 + 17 + 16 + 18);
+    // 8 commands, 18 diagnostics, 8 x 2 COLREGS, 3 x 3 x 2 predictions.
+    assert_eq!(checked, 8 + 18 + 16 + 18);
 }
 
 #[test]
@@ -132,9 +132,11 @@ fn non_finite_real_inputs_are_refused_naming_the_variable() {
 /// Sets one parameter on an instance; the status.
 type SetParameter = Box<dyn Fn(&fmi2_slave::testing::Fmu) -> Fmi2Status>;
 
+/// A value out of a parameter's range is refused when it is set (`fmi2Error`),
+/// naming the parameter and the range.
 #[test]
-fn bad_parameters_are_refused_at_exit_initialization_naming_them() {
-    let cases: [(&str, SetParameter); 8] = [
+fn out_of_range_parameters_are_refused_when_set_naming_them() {
+    let cases: [(&str, SetParameter); 6] = [
         (
             "architecture",
             Box::new(|f| f.set_integer(var("architecture"), 7)),
@@ -144,26 +146,43 @@ fn bad_parameters_are_refused_at_exit_initialization_naming_them() {
             Box::new(|f| f.set_integer(var("avoidance_scheme"), 0)),
         ),
         (
-            "sample_time",
-            Box::new(|f| f.set_real(var("sample_time"), -1.0)),
+            "mpc.sample_time",
+            Box::new(|f| f.set_real(var("mpc.sample_time"), -1.0)),
         ),
+        (
+            "mpc.hull_model",
+            Box::new(|f| f.set_integer(var("mpc.hull_model"), 3)),
+        ),
+        (
+            "admm.max_iterations",
+            Box::new(|f| f.set_integer(var("admm.max_iterations"), 0)),
+        ),
+        ("admm.rho", Box::new(|f| f.set_real(var("admm.rho"), -0.5))),
+    ];
+    for (name, set) in &cases {
+        let fmu = controller(name);
+        set_states(&fmu, &paper_states());
+        assert_eq!(set(&fmu), Fmi2Status::Error, "{name} was accepted");
+        let text = fmu.last_text();
+        assert!(text.contains(&format!("`{name}`")), "{name}: {text}");
+        assert!(text.contains("must be"), "{name}: {text}");
+    }
+}
+
+/// What only the whole configuration shows is refused at exit initialization,
+/// naming the parameter: a log file that cannot be created, a pretension above the
+/// largest tension.
+#[test]
+fn bad_configurations_are_refused_at_exit_initialization_naming_them() {
+    let cases: [(&str, SetParameter); 2] = [
         (
             "log_file",
             Box::new(|f| f.set_string(var("log_file"), "/nonexistent-dir/run.mcap")),
         ),
         (
-            "hull_model",
-            Box::new(|f| f.set_integer(var("hull_model"), 3)),
+            "mpc.ship.min_tension",
+            Box::new(|f| f.set_real(var("mpc.ship.min_tension"), 5.0)),
         ),
-        (
-            "max_iterations",
-            Box::new(|f| f.set_integer(var("max_iterations"), 0)),
-        ),
-        (
-            "prediction_horizon",
-            Box::new(|f| f.set_integer(var("prediction_horizon"), 5)),
-        ),
-        ("rho", Box::new(|f| f.set_real(var("rho"), -0.5))),
     ];
     for (name, set) in &cases {
         let fmu = controller(name);
@@ -185,10 +204,21 @@ fn a_valid_non_default_parameter_set_is_accepted() {
     set_states(&fmu, &paper_states());
     assert_eq!(fmu.set_integer(var("architecture"), 1), Fmi2Status::Ok);
     assert_eq!(fmu.set_integer(var("avoidance_scheme"), 3), Fmi2Status::Ok);
-    assert_eq!(fmu.set_integer(var("hull_model"), 1), Fmi2Status::Ok);
-    assert_eq!(fmu.set_real(var("max_tension"), 2.0), Fmi2Status::Ok);
     assert_eq!(
-        fmu.set_real(var("waterway_half_width"), 4.0),
+        fmu.set_boolean(var("mpc.hull_from_scenario"), false),
+        Fmi2Status::Ok
+    );
+    assert_eq!(fmu.set_integer(var("mpc.hull_model"), 1), Fmi2Status::Ok);
+    assert_eq!(
+        fmu.set_real(var("mpc.ship.max_tension"), 2.0),
+        Fmi2Status::Ok
+    );
+    assert_eq!(
+        fmu.set_boolean(var("waterway.from_scenario"), false),
+        Fmi2Status::Ok
+    );
+    assert_eq!(
+        fmu.set_real(var("waterway.half_width"), 4.0),
         Fmi2Status::Ok
     );
     fmu.init(0.0, None);
@@ -273,7 +303,7 @@ fn sampling_is_independent_of_the_communication_step() {
     // sample_time 0.5 s with h = 0.25: samples at 0, 0.5, 1.0, 1.5.
     let fmu = controller("half");
     set_states(&fmu, &paper_states());
-    assert_eq!(fmu.set_real(var("sample_time"), 0.5), Fmi2Status::Ok);
+    assert_eq!(fmu.set_real(var("mpc.sample_time"), 0.5), Fmi2Status::Ok);
     fmu.init(0.0, None);
     steps(&fmu, 0.0, 0.25, 8);
     assert_eq!(fmu.get_integer(vars::SAMPLES), 4);

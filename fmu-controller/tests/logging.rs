@@ -77,7 +77,10 @@ fn every_sample_logs_every_topic_once() {
         .map(|(_, d)| serde_json::from_slice(d).unwrap())
         .collect();
     assert_eq!(solver.last().unwrap().samples, samples as u64);
-    assert_eq!(solver[0].architecture, fmu.get_integer(vars::ARCHITECTURE));
+    assert_eq!(
+        solver[0].architecture,
+        fmu.get_integer(vars::parameter_vr_of("architecture").unwrap())
+    );
     assert!(solver.iter().all(|s| s.fallback.is_none()));
     let colregs: Colregs =
         serde_json::from_slice(&msgs[names::CONTROLLER_COLREGS].last().unwrap().1).unwrap();
@@ -123,10 +126,10 @@ fn every_sample_logs_every_topic_once() {
     assert_eq!(run.metadata["unit"], "TowingController");
     assert_eq!(run.metadata["guid"], DESCRIPTION.guid());
     let params: serde_json::Value = serde_json::from_str(&run.metadata["parameters"]).unwrap();
-    assert!(params["sample_time"].is_number(), "{params}");
+    assert!(params["mpc.sample_time"].is_number(), "{params}");
     assert_eq!(
         params["avoidance_scheme"],
-        fmu.get_integer(vars::AVOIDANCE_SCHEME)
+        fmu.get_integer(vars::parameter_vr_of("avoidance_scheme").unwrap())
     );
     assert_eq!(summary.attachment_indexes.len(), 1);
 }

@@ -44,86 +44,98 @@ fn start_integer(name: &str) -> i32 {
     }
 }
 
+fn start_boolean(name: &str) -> bool {
+    let v = DESCRIPTION
+        .variables
+        .iter()
+        .find(|v| v.name == name)
+        .unwrap();
+    match v.kind {
+        VariableKind::Boolean { start: Some(s) } => s,
+        _ => panic!("{name} is not a Boolean with a start value"),
+    }
+}
+
 /// Each parameter against the field of `ControllerConfig::new(Scenario::paper())` it sets,
-/// written out independently of the variable table.
+/// written out independently of the registry, and every registry entry declared.
 #[test]
 fn parameter_start_values_are_the_rust_defaults() {
     let c = ControllerConfig::new(Scenario::paper().unwrap());
-    let ts = c.prediction.sample_time;
+    let t = &c.tuning;
     let expected: Vec<(&str, f64)> = vec![
-        ("sample_time", ts),
-        ("prediction_step", c.prediction.integration_step),
-        ("altering_angle", c.guidance.altering_angle),
-        ("w_S1", c.ship.weight_position),
-        ("w_S2", c.ship.weight_surge),
-        ("w_S3", c.ship.weight_distance),
-        ("w_T1", c.tug.weight_position),
-        ("w_T2", c.tug.weight_surge),
-        ("w_T3", c.tug.weight_distance),
-        ("eps_abs", c.admm.eps_abs),
-        ("eps_rel", c.admm.eps_rel),
-        ("max_tension", c.ship.max_tension),
-        ("max_towing_angle", c.ship.max_angle),
-        ("tension_rate", c.ship.tension_rate),
-        ("angle_rate", c.ship.angle_rate),
-        ("max_thrust_surge", c.tug.thrust_limit[0]),
-        ("max_thrust_sway", c.tug.thrust_limit[1]),
-        ("max_yaw_moment", c.tug.thrust_limit[2]),
-        ("rho", c.admm.rho),
-        ("detection_distance", c.guidance.detection_distance),
+        ("mpc.sample_time", t.prediction.sample_time),
+        ("mpc.prediction_step", t.prediction.integration_step),
+        ("mpc.sample_time_budget", 0.0),
+        ("guidance.altering_angle", t.guidance.altering_angle),
+        ("mpc.ship.weight_position", t.ship.weight_position),
+        ("mpc.ship.weight_heading", t.ship.weight_heading),
+        ("mpc.ship.weight_surge", t.ship.weight_surge),
+        ("mpc.ship.weight_sway", t.ship.weight_sway),
+        ("mpc.ship.weight_yaw_rate", t.ship.weight_yaw_rate),
+        ("mpc.ship.weight_distance", t.ship.weight_distance),
+        ("mpc.tug.weight_position", t.tug.weight_position),
+        ("mpc.tug.weight_surge", t.tug.weight_surge),
+        ("mpc.tug.weight_distance", t.tug.weight_distance),
+        ("admm.eps_abs", t.admm.eps_abs),
+        ("admm.eps_rel", t.admm.eps_rel),
+        ("mpc.ship.max_tension", t.ship.max_tension),
+        ("mpc.ship.max_towing_angle", t.ship.max_angle),
+        ("mpc.ship.tension_rate", t.ship.tension_rate),
+        ("mpc.ship.towing_angle_rate", t.ship.angle_rate),
+        ("mpc.tug.max_force_surge", t.tug.thrust_limit[0]),
+        ("mpc.tug.max_force_sway", t.tug.thrust_limit[1]),
+        ("mpc.tug.max_moment_yaw", t.tug.thrust_limit[2]),
+        ("admm.rho", t.admm.rho),
+        ("guidance.detection_distance", t.guidance.detection_distance),
         (
-            "static_detection_distance",
-            c.guidance.static_detection_distance,
+            "guidance.static_detection_distance",
+            t.guidance.static_detection_distance,
         ),
-        ("safety_buffer", c.guidance.safety_buffer),
-        ("acceptance_radius", c.guidance.acceptance_radius),
-        ("min_tension", c.ship.min_tension),
-        ("angle_weight", c.ship.weight_towing_angle),
-        ("tension_weight", c.ship.weight_tension),
-        ("inner_loop_gain_surge", c.inner.gain[0]),
-        ("inner_loop_gain_sway", c.inner.gain[1]),
-        ("inner_loop_gain_yaw", c.inner.gain[2]),
-        ("w_S2_yaw", c.ship.weight_yaw_rate),
-        ("lookahead", c.tracking.lookahead),
-        ("los_distance", c.tracking.los_distance),
-        ("give_way_lookahead", c.tracking.give_way_lookahead),
-        ("port_turn_margin", c.tracking.port_turn_margin),
-        ("port_turn_weight", c.ship.weight_port_turn),
+        ("guidance.safety_buffer", t.guidance.safety_buffer),
+        ("guidance.acceptance_radius", t.guidance.acceptance_radius),
+        ("mpc.ship.min_tension", t.ship.min_tension),
+        ("mpc.ship.weight_towing_angle", t.ship.weight_towing_angle),
+        ("mpc.ship.weight_tension", t.ship.weight_tension),
+        ("inner_loop.bandwidth_surge", t.inner.gain[0]),
+        ("inner_loop.bandwidth_sway", t.inner.gain[1]),
+        ("inner_loop.bandwidth_yaw", t.inner.gain[2]),
+        ("tracking.lookahead", t.tracking.lookahead),
+        ("tracking.los_distance", t.tracking.los_distance),
+        ("tracking.give_way_lookahead", t.tracking.give_way_lookahead),
+        ("tracking.port_turn_margin", t.tracking.port_turn_margin),
+        ("mpc.ship.weight_port_turn", t.ship.weight_port_turn),
         (
-            "centralized_thrust_rate_weight",
-            c.centralized.weight_force_rate,
+            "centralized.weight_force_rate",
+            t.centralized.weight_force_rate,
         ),
+        ("waterway.half_width", 5.0),
     ];
     for (name, value) in &expected {
         assert_eq!(start_real(name), *value, "start value of {name}");
     }
-    // 0 means "from the scenario" (the paper scenario has a waterway).
-    assert_eq!(start_real("waterway_half_width"), 0.0);
-    assert!(c.guidance.waterway_half_width.is_some());
     // Table 3 values, as the brief of the FMU states them.
-    assert_eq!(start_real("w_S2"), 75.0);
-    assert_eq!(start_real("w_T2"), 6.0);
-    assert!((start_real("altering_angle") - 15f64.to_radians()).abs() < 1e-15);
-    assert!((start_real("tension_rate") - 0.3).abs() < 1e-15);
+    assert_eq!(start_real("mpc.ship.weight_surge"), 75.0);
+    assert_eq!(start_real("mpc.tug.weight_surge"), 6.0);
+    assert!((start_real("guidance.altering_angle") - 15f64.to_radians()).abs() < 1e-15);
+    assert!((start_real("mpc.ship.tension_rate") - 0.3).abs() < 1e-15);
+    // Values from the scenario are switched, not sentinels.
+    assert!(start_boolean("mpc.hull_from_scenario"));
+    assert!(start_boolean("waterway.from_scenario"));
+    assert!(c.guidance().waterway_half_width.is_some());
 
-    assert_eq!(start_integer("hull_model"), 0);
-    assert_eq!(start_integer("architecture"), c.architecture.code());
-    assert_eq!(start_integer("avoidance_scheme"), c.scheme.code());
+    assert_eq!(start_integer("architecture"), t.architecture.code());
+    assert_eq!(start_integer("avoidance_scheme"), t.scheme.code());
     assert_eq!(
-        start_integer("max_iterations"),
-        i32::try_from(c.admm.max_iterations).unwrap()
-    );
-    assert_eq!(
-        start_integer("prediction_horizon"),
-        i32::try_from(towing_mpc::HORIZON).unwrap()
+        start_integer("admm.max_iterations"),
+        i32::try_from(t.admm.max_iterations).unwrap()
     );
     let n_params = DESCRIPTION
         .variables
         .iter()
         .filter(|v| v.causality == Causality::Parameter)
         .count();
-    // 2 String + 5 Integer + the Reals above and waterway_half_width.
-    assert_eq!(n_params, 2 + 5 + expected.len() + 1);
+    // 2 String + every registry entry.
+    assert_eq!(n_params, 2 + towing_control::PARAMETERS.len());
 }
 
 /// Every name a master connects by must exist in both FMUs with the same type and unit.

@@ -13,6 +13,7 @@
 //! `towing-interface`'s [`RunSession`], which the controller uses too.
 
 use crate::logging::{self, LogScenario, StepSnapshot};
+use crate::params::{PlantParams, PARAMETERS};
 use crate::variables::{self as vars, PlantVariable};
 use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome, ValueType};
 use std::sync::Arc;
@@ -21,87 +22,12 @@ use towing_interface::codec::{
 };
 use towing_interface::{LogHeader, RunSession, ScenarioFile};
 use towing_log::topics::Log;
-use towing_model::{
-    HullModel, ObstacleSlot, Scenario, TowlineModel, TowlineOutput, World, WorldConfig, WorldInputs,
-};
+use towing_model::registry::{Kind, Value};
+use towing_model::{ObstacleSlot, TowlineOutput, World, WorldInputs};
 
 /// Version of [`Plant`]'s serialized state; bump on any layout change.
-const STATE_FORMAT_VERSION: u16 = 1;
+const STATE_FORMAT_VERSION: u16 = 2;
 const STATE_MAGIC: &[u8; 4] = b"TWPL";
-
-/// Parameter values (FMI `parameter` variables); the model parameters are all 0 (empty) by
-/// default: as the scenario says, the bundled scenario.
-#[derive(Debug, Clone, PartialEq)]
-struct Parameters {
-    /// Interval of the Foxglove topics `/tf` and `/plant/scene` in the log, s; 0: every step.
-    log_scene_interval: f64,
-    hull_model: i32,
-    towline_model: i32,
-    integration_step: f64,
-}
-
-impl Default for Parameters {
-    fn default() -> Self {
-        Self {
-            log_scene_interval: vars::LOG_SCENE_INTERVAL_START,
-            hull_model: 0,
-            towline_model: 0,
-            integration_step: 0.0,
-        }
-    }
-}
-
-impl Parameters {
-    /// Checks the values alone (before any scenario is read).
-    fn validate(&self) -> Result<(), String> {
-        if !(0..=2).contains(&self.hull_model) {
-            return Err(format!(
-                "hull_model must be 0 (as the scenario says), 1 (linear damping) or 2 (nonlinear damping), got {}",
-                self.hull_model
-            ));
-        }
-        if !(0..=2).contains(&self.towline_model) {
-            return Err(format!(
-                "towline_model must be 0 (as the scenario says), 1 (ideal winch) or 2 (elastic line), got {}",
-                self.towline_model
-            ));
-        }
-        let d = self.log_scene_interval;
-        if !(d.is_finite() && d >= 0.0) {
-            return Err(format!(
-                "log_scene_interval must be 0 (every step) or a positive number of seconds, got {d} s"
-            ));
-        }
-        let h = self.integration_step;
-        if !(h == 0.0 || (h > 0.0 && h <= WorldConfig::MAX_INTEGRATION_STEP)) {
-            return Err(format!(
-                "integration_step must be 0 (as the scenario says) or in (0, {}] s, got {h} s",
-                WorldConfig::MAX_INTEGRATION_STEP
-            ));
-        }
-        Ok(())
-    }
-
-    /// The world configuration: the scenario's `[simulation]` section, overridden by every
-    /// parameter that is not 0.
-    fn world_config(&self, scenario: &Scenario) -> WorldConfig {
-        let mut config = scenario.world_config;
-        match self.hull_model {
-            1 => config.hull_model = HullModel::LinearDamping,
-            2 => config.hull_model = HullModel::NonlinearDamping,
-            _ => {}
-        }
-        match self.towline_model {
-            1 => config.towline_model = TowlineModel::IdealWinch,
-            2 => config.towline_model = scenario.elastic_towline.into(),
-            _ => {}
-        }
-        if self.integration_step > 0.0 {
-            config.integration_step = self.integration_step;
-        }
-        config
-    }
-}
 
 /// What the plant builds from the loaded scenario: the world, and what the log needs from
 /// the scenario.
@@ -115,7 +41,8 @@ struct Built {
 /// The towing plant: ship, two tugs, two towlines and traffic.
 #[derive(Debug, Clone)]
 pub struct Plant {
-    params: Parameters,
+    /// The parameters' values (the registry's, [`crate::params`]).
+    params: PlantParams,
     inputs: WorldInputs,
     /// Set once initialization mode was entered: parameter changes then reload at once.
     initializing: bool,
@@ -131,7 +58,6 @@ pub struct Plant {
 impl Plant {
     /// Reads the scenario named by the `scenario` parameter (or the bundled one) and builds the world.
     fn load(&mut self, log: &Logger) -> Result<(), String> {
-        self.params.validate()?;
         let params = &self.params;
         let built = self.session.load(|file| {
             let scenario = &file.scenario;
@@ -157,6 +83,20 @@ impl Plant {
         Ok(())
     }
 
+    /// Sets the registry's parameter `index`, checked against its range; during
+    /// initialization the world is rebuilt with it (and the old value kept if that
+    /// fails).
+    fn set_parameter(&mut self, log: &Logger, index: usize, value: Value) -> Result<(), String> {
+        let p = &PARAMETERS[index];
+        p.check(&value)
+            .map_err(|e| format!("parameter `{}`: {}", e.field, e.reason))?;
+        let previous = self.params;
+        p.set(&mut self.params, value)
+            .map_err(|e| format!("parameter `{}`: {}", e.field, e.reason))?;
+        self.reload_if_initializing(log)
+            .inspect_err(|_| self.params = previous)
+    }
+
     fn reload_if_initializing(&mut self, log: &Logger) -> Result<(), String> {
         if self.initializing {
             self.load(log)
@@ -177,15 +117,18 @@ impl Plant {
         };
         let t = self.start_time;
         let guid = vars::DESCRIPTION.guid();
-        let p = &self.params;
-        let parameters = serde_json::json!({
-            "scenario": self.session.scenario_parameter(),
-            "log_file": self.session.log_file(),
-            "log_scene_interval": p.log_scene_interval,
-            "hull_model": p.hull_model,
-            "towline_model": p.towline_model,
-            "integration_step": p.integration_step,
-        });
+        let mut parameters = serde_json::Map::new();
+        parameters.insert("scenario".into(), self.session.scenario_parameter().into());
+        parameters.insert("log_file".into(), self.session.log_file().into());
+        for p in PARAMETERS {
+            let value = match p.get(&self.params) {
+                Value::Real(v) => v.into(),
+                Value::Integer(v) => v.into(),
+                Value::Boolean(v) => v.into(),
+            };
+            parameters.insert(p.name.into(), value);
+        }
+        let parameters = serde_json::Value::Object(parameters);
         let header = LogHeader {
             unit: vars::MODEL_IDENTIFIER,
             guid: &guid,
@@ -236,7 +179,7 @@ impl Fmi2Model for Plant {
 
     fn instantiate(ctx: &InstanceContext<'_>) -> Result<Self, String> {
         Ok(Self {
-            params: Parameters::default(),
+            params: PlantParams::default(),
             inputs: WorldInputs::default(),
             initializing: false,
             session: RunSession::new(ctx.resource_dir),
@@ -272,8 +215,16 @@ impl Fmi2Model for Plant {
     fn get_real(&self, vr: u32) -> Result<f64, String> {
         use ContractVariable as C;
         Ok(match vars::VARIABLES.decode(ValueType::Real, vr)? {
-            PlantVariable::IntegrationStep => self.params.integration_step,
-            PlantVariable::LogSceneInterval => self.params.log_scene_interval,
+            PlantVariable::Parameter(i) => match PARAMETERS[i].get(&self.params) {
+                Value::Real(v) => v,
+                _ => {
+                    return Err(vars::VARIABLES.unhandled(
+                        ValueType::Real,
+                        PlantVariable::Parameter(i),
+                        "get",
+                    ))
+                }
+            },
             PlantVariable::Contract(C::TugForce(tug, c)) => {
                 self.inputs.tug_tau[tug.index()][c.index()]
             }
@@ -281,28 +232,13 @@ impl Fmi2Model for Plant {
             PlantVariable::Contract(c) => real_output(self.world(), c).ok_or_else(|| {
                 vars::VARIABLES.unhandled(ValueType::Real, PlantVariable::Contract(c), "get")
             })?,
-            other => return Err(vars::VARIABLES.unhandled(ValueType::Real, other, "get")),
         })
     }
 
     fn set_real(&mut self, log: &Logger, vr: u32, value: f64) -> Result<(), String> {
         use ContractVariable as C;
         match vars::VARIABLES.decode(ValueType::Real, vr)? {
-            PlantVariable::LogSceneInterval => {
-                let previous = self.params.log_scene_interval;
-                self.params.log_scene_interval = value;
-                self.params.validate().inspect_err(|_| {
-                    self.params.log_scene_interval = previous;
-                })
-            }
-            PlantVariable::IntegrationStep => {
-                let previous = self.params.clone();
-                self.params.integration_step = value;
-                self.params
-                    .validate()
-                    .and_then(|()| self.reload_if_initializing(log))
-                    .inspect_err(|_| self.params = previous)
-            }
+            PlantVariable::Parameter(i) => self.set_parameter(log, i, Value::Real(value)),
             PlantVariable::Contract(C::TugForce(tug, c)) => {
                 self.inputs.tug_tau[tug.index()][c.index()] = value;
                 Ok(())
@@ -318,8 +254,16 @@ impl Fmi2Model for Plant {
     fn get_integer(&self, vr: u32) -> Result<i32, String> {
         use ContractVariable as C;
         Ok(match vars::VARIABLES.decode(ValueType::Integer, vr)? {
-            PlantVariable::HullModel => self.params.hull_model,
-            PlantVariable::TowlineModel => self.params.towline_model,
+            PlantVariable::Parameter(i) => match PARAMETERS[i].get(&self.params) {
+                Value::Integer(v) => v,
+                _ => {
+                    return Err(vars::VARIABLES.unhandled(
+                        ValueType::Integer,
+                        PlantVariable::Parameter(i),
+                        "get",
+                    ))
+                }
+            },
             PlantVariable::Contract(C::Obstacle(slot, ObstacleField::Kind)) => self
                 .world()
                 .map_or(0, |w| obstacle_kind_code(w.obstacle(slot.index()).kind)),
@@ -328,20 +272,22 @@ impl Fmi2Model for Plant {
     }
 
     fn set_integer(&mut self, log: &Logger, vr: u32, value: i32) -> Result<(), String> {
-        let previous = self.params.clone();
         match vars::VARIABLES.decode(ValueType::Integer, vr)? {
-            PlantVariable::HullModel => self.params.hull_model = value,
-            PlantVariable::TowlineModel => self.params.towline_model = value,
-            _ => return Err(format!("value reference {vr} is not a settable Integer")),
+            PlantVariable::Parameter(i) => self.set_parameter(log, i, Value::Integer(value)),
+            _ => Err(format!("value reference {vr} is not a settable Integer")),
         }
-        self.params
-            .validate()
-            .and_then(|()| self.reload_if_initializing(log))
-            .inspect_err(|_| self.params = previous)
     }
 
     fn get_boolean(&self, vr: u32) -> Result<bool, String> {
         match vars::VARIABLES.decode(ValueType::Boolean, vr)? {
+            PlantVariable::Parameter(i) => match PARAMETERS[i].get(&self.params) {
+                Value::Boolean(v) => Ok(v),
+                _ => Err(vars::VARIABLES.unhandled(
+                    ValueType::Boolean,
+                    PlantVariable::Parameter(i),
+                    "get",
+                )),
+            },
             PlantVariable::Contract(ContractVariable::Towline(line, TowlineField::Slack)) => {
                 Ok(self.world().is_none_or(|w| w.towline(line.index()).slack))
             }
@@ -349,9 +295,11 @@ impl Fmi2Model for Plant {
         }
     }
 
-    fn set_boolean(&mut self, _log: &Logger, vr: u32, _value: bool) -> Result<(), String> {
-        vars::VARIABLES.decode(ValueType::Boolean, vr)?;
-        Err(format!("value reference {vr} is not a settable Boolean"))
+    fn set_boolean(&mut self, log: &Logger, vr: u32, value: bool) -> Result<(), String> {
+        match vars::VARIABLES.decode(ValueType::Boolean, vr)? {
+            PlantVariable::Parameter(i) => self.set_parameter(log, i, Value::Boolean(value)),
+            _ => Err(format!("value reference {vr} is not a settable Boolean")),
+        }
     }
 
     fn get_string(&self, vr: u32) -> Result<String, String> {
@@ -427,9 +375,13 @@ impl Fmi2Model for Plant {
         out.extend_from_slice(STATE_MAGIC);
         out.extend_from_slice(&STATE_FORMAT_VERSION.to_le_bytes());
         put_str(out, self.session.scenario_parameter());
-        out.extend_from_slice(&self.params.hull_model.to_le_bytes());
-        out.extend_from_slice(&self.params.towline_model.to_le_bytes());
-        out.extend_from_slice(&self.params.integration_step.to_le_bytes());
+        for p in PARAMETERS {
+            match p.get(&self.params) {
+                Value::Real(v) => out.extend_from_slice(&v.to_le_bytes()),
+                Value::Integer(v) => out.extend_from_slice(&v.to_le_bytes()),
+                Value::Boolean(v) => out.push(u8::from(v)),
+            }
+        }
         for tau in &self.inputs.tug_tau {
             for x in tau {
                 out.extend_from_slice(&x.to_le_bytes());
@@ -464,12 +416,17 @@ impl Fmi2Model for Plant {
             ));
         }
         let scenario_parameter = r.string()?;
-        let params = Parameters {
-            log_scene_interval: self.params.log_scene_interval,
-            hull_model: i32::from_le_bytes(r.array()?),
-            towline_model: i32::from_le_bytes(r.array()?),
-            integration_step: f64::from_le_bytes(r.array()?),
-        };
+        let mut params = PlantParams::default();
+        for p in PARAMETERS {
+            let value = match p.kind {
+                Kind::Real { .. } => Value::Real(f64::from_le_bytes(r.array()?)),
+                Kind::Integer { .. } => Value::Integer(i32::from_le_bytes(r.array()?)),
+                Kind::Boolean { .. } => Value::Boolean(r.take(1)?[0] != 0),
+            };
+            p.check(&value)
+                .map_err(|e| format!("TowingPlant state: parameter `{}`: {}", e.field, e.reason))?;
+            p.set(&mut params, value).map_err(|e| e.to_string())?;
+        }
         let mut inputs = WorldInputs::default();
         for tau in &mut inputs.tug_tau {
             for x in tau.iter_mut() {
@@ -495,7 +452,6 @@ impl Fmi2Model for Plant {
             let origin = r.string()?;
             let text = r.string()?;
             let world_bytes = r.bytes()?;
-            restored.params.validate()?;
             let file = ScenarioFile::parse(origin, text)?;
             let config = restored.params.world_config(&file.scenario);
             let mut world =

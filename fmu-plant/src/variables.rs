@@ -7,7 +7,8 @@
 //! The connected variables (vessel states, towline values and obstacle slots as outputs, the
 //! commands as inputs) and their value references, units and declared types are those of
 //! the interface contract, `towing-interface` (with the String parameters `scenario` and
-//! `log_file`); this module adds the plant's own parameters (value references 2..=9) and
+//! `log_file`); this module adds the plant's own parameters (the registry of
+//! [`crate::params`], value references `10 + index`) and
 //! the Boolean outputs `towlineN.slack` (the contract's [`TowlineField::Slack`]).
 //!
 //! The plant's getters and setters decode every value reference through [`VARIABLES`]
@@ -22,23 +23,28 @@ use towing_interface::codec::{
 use towing_interface::types::real_kind;
 use towing_interface::variables::{self as shared, parameter, Direction};
 use towing_interface::ModelInfo;
-use towing_model::WorldConfig;
+use towing_model::registry::Kind;
+
+use crate::params::{PlantParams, PARAMETERS};
 
 pub use towing_interface::vr::{
     obstacle, tension_cmd, towline, tug_force, vessel_state, LOG_FILE, OBSTACLE_KIND, SCENARIO,
 };
 
-/// `hull_model` (Integer parameter): 1 linear damping, 2 nonlinear damping.
-pub const HULL_MODEL: u32 = 2;
-/// `towline_model` (Integer parameter): 1 ideal winch, 2 elastic line with winch.
-pub const TOWLINE_MODEL: u32 = 3;
-/// `integration_step` (Real parameter, s): largest RK4 substep.
-pub const INTEGRATION_STEP: u32 = 4;
+/// Value reference of the registry's parameter `index` ([`PARAMETERS`]).
+#[must_use]
+pub const fn parameter_vr(index: usize) -> u32 {
+    10 + index as u32
+}
 
-/// `log_scene_interval` (Real parameter, s): interval of `/tf` and `/plant/scene` in the log.
-pub const LOG_SCENE_INTERVAL: u32 = 5;
-/// Start value of `log_scene_interval`, s.
-pub const LOG_SCENE_INTERVAL_START: f64 = 0.5;
+/// Value reference of the plant parameter `name`.
+#[must_use]
+pub fn parameter_vr_of(name: &str) -> Option<u32> {
+    PARAMETERS
+        .iter()
+        .position(|p| p.name == name)
+        .map(parameter_vr)
+}
 
 /// A variable of the plant, as its getters and setters see it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -46,32 +52,26 @@ pub enum PlantVariable {
     /// A variable of the interface contract: the plant declares every one (the commands as
     /// inputs, the rest as outputs, `towlineN.slack` its own).
     Contract(ContractVariable),
-    /// `log_scene_interval` (Real parameter, s).
-    LogSceneInterval,
-    /// `hull_model` (Integer parameter).
-    HullModel,
-    /// `towline_model` (Integer parameter).
-    TowlineModel,
-    /// `integration_step` (Real parameter, s).
-    IntegrationStep,
+    /// A parameter: its index in the registry ([`PARAMETERS`]).
+    Parameter(usize),
 }
 
 impl ModelVariable for PlantVariable {
     fn value_reference(self) -> u32 {
         match self {
             PlantVariable::Contract(c) => c.encode(),
-            PlantVariable::LogSceneInterval => LOG_SCENE_INTERVAL,
-            PlantVariable::HullModel => HULL_MODEL,
-            PlantVariable::TowlineModel => TOWLINE_MODEL,
-            PlantVariable::IntegrationStep => INTEGRATION_STEP,
+            PlantVariable::Parameter(i) => parameter_vr(i),
         }
     }
 
     fn value_type(self) -> ValueType {
         match self {
             PlantVariable::Contract(c) => c.value_type(),
-            PlantVariable::LogSceneInterval | PlantVariable::IntegrationStep => ValueType::Real,
-            PlantVariable::HullModel | PlantVariable::TowlineModel => ValueType::Integer,
+            PlantVariable::Parameter(i) => match PARAMETERS[i].kind {
+                Kind::Real { .. } => ValueType::Real,
+                Kind::Integer { .. } => ValueType::Integer,
+                Kind::Boolean { .. } => ValueType::Boolean,
+            },
         }
     }
 
@@ -85,12 +85,7 @@ impl ModelVariable for PlantVariable {
 
 /// The plant's variables by value reference, built once.
 pub static VARIABLES: LazyLock<VariableTable<PlantVariable>> = LazyLock::new(|| {
-    let own = [
-        PlantVariable::LogSceneInterval,
-        PlantVariable::HullModel,
-        PlantVariable::TowlineModel,
-        PlantVariable::IntegrationStep,
-    ];
+    let own = (0..PARAMETERS.len()).map(PlantVariable::Parameter);
     VariableTable::new(
         MODEL_IDENTIFIER,
         ContractVariable::all()
@@ -117,62 +112,49 @@ pub const MODEL_IDENTIFIER: &str = "TowingPlant";
 /// The plant's model description, built once.
 pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(build);
 
+/// The model-description variable of the registry's parameter `index`.
+fn parameter_variable(index: usize) -> fmi2_slave::description::Variable {
+    let p = &PARAMETERS[index];
+    let defaults = PlantParams::default();
+    let kind = match p.kind {
+        Kind::Real {
+            unit,
+            min,
+            max,
+            get,
+            ..
+        } => {
+            let mut kind = real_kind(unit, Some(get(&defaults)));
+            if let VariableKind::Real {
+                min: lo, max: hi, ..
+            } = &mut kind
+            {
+                *lo = min.value();
+                *hi = max.value();
+            }
+            kind
+        }
+        Kind::Integer { min, max, get, .. } => VariableKind::Integer {
+            declared_type: None,
+            start: Some(get(&defaults)),
+            min: Some(min),
+            max: Some(max),
+        },
+        Kind::Boolean { get, .. } => VariableKind::Boolean {
+            start: Some(get(&defaults)),
+        },
+    };
+    parameter(p.name, parameter_vr(index), kind, p.description)
+}
+
 fn build() -> ModelDescription {
-    let integration_step = {
-        let mut kind = real_kind("s", Some(0.0));
-        if let VariableKind::Real { min, max, .. } = &mut kind {
-            *min = Some(0.0);
-            *max = Some(WorldConfig::MAX_INTEGRATION_STEP);
-        }
-        kind
-    };
-    let log_scene_interval = {
-        let mut kind = real_kind("s", Some(LOG_SCENE_INTERVAL_START));
-        if let VariableKind::Real { min, .. } = &mut kind {
-            *min = Some(0.0);
-        }
-        kind
-    };
     let mut v = vec![
         shared::scenario_parameter(
             "Path of the scenario file (TOML, docs/scenario-format.md); empty: the bundled paper scenario resources/paper.toml",
         ),
         shared::log_file_parameter(),
-        parameter(
-            "log_scene_interval",
-            LOG_SCENE_INTERVAL,
-            log_scene_interval,
-            "Interval of the Foxglove topics /tf and /plant/scene in the MCAP log (docs/logging.md): written at the first step that reaches each multiple of it after the start time; 0: every step. Every other plant topic is written every step",
-        ),
-        parameter(
-            "hull_model",
-            HULL_MODEL,
-            VariableKind::Integer {
-                declared_type: None,
-                start: Some(0),
-                min: Some(0),
-                max: Some(2),
-            },
-            "Hull damping model: 0 as the scenario's [simulation] section says (default nonlinear), 1 linear (constant D, the paper's eq. (1)), 2 nonlinear (Skjetne et al. 2004 for CyberShip II)",
-        ),
-        parameter(
-            "towline_model",
-            TOWLINE_MODEL,
-            VariableKind::Integer {
-                declared_type: None,
-                start: Some(0),
-                min: Some(0),
-                max: Some(2),
-            },
-            "Towline model: 0 as the scenario's [simulation] section says (default ideal winch), 1 ideal winch holding the commanded tension while taut, 2 elastic line paid out by a winch (constants from the scenario)",
-        ),
-        parameter(
-            "integration_step",
-            INTEGRATION_STEP,
-            integration_step,
-            "Largest fixed RK4 substep; a communication step h is split into ceil(h / integration_step) equal substeps; 0: as the scenario says (default 0.01 s)",
-        ),
     ];
+    v.extend((0..PARAMETERS.len()).map(parameter_variable));
     v.extend(shared::commands(Direction::Input));
     v.extend(shared::vessel_states(Direction::Output));
     for line in Towline::ALL {

@@ -147,14 +147,18 @@ fn non_finite_inputs_are_refused_naming_the_variable_and_keeping_the_value() {
 #[test]
 fn bad_parameters_are_refused_naming_the_parameter() {
     let fmu = plant("params");
-    assert_eq!(fmu.set_integer(vars::HULL_MODEL, 7), Fmi2Status::Error);
-    assert!(fmu.last_text().contains("hull_model") && fmu.last_text().contains('7'));
+    let vr = |name| vars::parameter_vr_of(name).unwrap();
+    assert_eq!(fmu.set_integer(vr("model.hull"), 7), Fmi2Status::Error);
+    assert!(fmu.last_text().contains("model.hull") && fmu.last_text().contains('7'));
     let fmu = plant("params2");
-    assert_eq!(fmu.set_real(vars::INTEGRATION_STEP, 0.5), Fmi2Status::Error);
-    testing::assert_last_message_contains(&fmu, "integration_step");
+    assert_eq!(
+        fmu.set_real(vr("model.integration_step"), 0.5),
+        Fmi2Status::Error
+    );
+    testing::assert_last_message_contains(&fmu, "model.integration_step");
     let fmu = plant("params3");
-    assert_eq!(fmu.set_integer(vars::TOWLINE_MODEL, -1), Fmi2Status::Error);
-    testing::assert_last_message_contains(&fmu, "towline_model");
+    assert_eq!(fmu.set_integer(vr("model.towline"), -1), Fmi2Status::Error);
+    testing::assert_last_message_contains(&fmu, "model.towline");
 }
 
 /// The paper scenario with one replacement applied (the original text must be present).
@@ -386,7 +390,12 @@ fn corrupted_serialized_state_is_refused() {
 #[test]
 fn hull_model_parameter_overrides_the_scenario() {
     let linear = plant("linear");
-    assert_eq!(linear.set_integer(vars::HULL_MODEL, 1), Fmi2Status::Ok);
+    let vr = |name| vars::parameter_vr_of(name).unwrap();
+    assert_eq!(
+        linear.set_boolean(vr("model.hull_from_scenario"), false),
+        Fmi2Status::Ok
+    );
+    assert_eq!(linear.set_integer(vr("model.hull"), 1), Fmi2Status::Ok);
     let nonlinear = plant("nonlinear");
     for fmu in [&linear, &nonlinear] {
         fmu.init(0.0, None);

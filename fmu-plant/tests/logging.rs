@@ -130,8 +130,8 @@ fn a_run_logs_every_topic_once_at_the_start_and_after_each_step() {
     assert_eq!(run.metadata["start_time"], "0");
     let params: serde_json::Value = serde_json::from_str(&run.metadata["parameters"]).unwrap();
     assert_eq!(params["log_file"], path.to_str().unwrap());
-    assert_eq!(params["hull_model"], 0);
-    assert_eq!(params["log_scene_interval"], 0.5);
+    assert_eq!(params["model.hull_from_scenario"], true);
+    assert_eq!(params["log.scene_interval"], 0.5);
     let att = mcap::read::attachment(&bytes, &summary.attachment_indexes[0]).unwrap();
     assert_eq!(att.name, "scenario.toml");
     assert_eq!(
@@ -147,7 +147,10 @@ fn scene_times(name: &str, interval: f64, t0: f64, h: f64, n: usize) -> Vec<u64>
     let path = dir.path().join(format!("{name}.mcap"));
     let fmu = plant_logging_to(name, &path);
     assert_eq!(
-        fmu.set_real(vars::LOG_SCENE_INTERVAL, interval),
+        fmu.set_real(
+            vars::parameter_vr_of("log.scene_interval").unwrap(),
+            interval
+        ),
         Fmi2Status::Ok
     );
     fmu.init(t0, None);
@@ -187,15 +190,19 @@ fn the_foxglove_topics_follow_log_scene_interval() {
 fn a_negative_log_scene_interval_is_refused_naming_it() {
     let fmu = testing::instantiate(exports(), &DESCRIPTION, "negative");
     assert_eq!(
-        fmu.set_real(vars::LOG_SCENE_INTERVAL, -1.0),
+        fmu.set_real(vars::parameter_vr_of("log.scene_interval").unwrap(), -1.0),
         Fmi2Status::Error
     );
     assert!(
-        fmu.log_text().contains("log_scene_interval must be 0"),
+        fmu.log_text()
+            .contains("parameter `log.scene_interval`: must be finite and >= 0 s"),
         "{}",
         fmu.log_text()
     );
-    assert_eq!(fmu.get_real(vars::LOG_SCENE_INTERVAL), 0.5);
+    assert_eq!(
+        fmu.get_real(vars::parameter_vr_of("log.scene_interval").unwrap()),
+        0.5
+    );
 }
 
 #[test]

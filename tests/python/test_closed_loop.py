@@ -6,7 +6,7 @@
   controller FMU is not needed.
 - A short run (60 s) of the paper scenario with both FMUs.
 - Model mismatch (marker `closed_loop_long`): the controller predicting with the linear
-  hull model (paper's eq. (1), `hull_model` = 1) against the plant's nonlinear hull, 1500 s
+  hull model (paper's eq. (1), `mpc.hull_model` = 1) against the plant's nonlinear hull, 1500 s
   of the paper scenario: no hull overlap, commands within their bounds, settles
   (docs/swap-plant.md).
 - The acceptance runs (marker `closed_loop_long`): 1200 s of the paper scenario for the
@@ -490,8 +490,10 @@ def test_linear_prediction_model_against_the_nonlinear_plant(plant_fmu, controll
     bounds, and settle at the destination (1500 s simulated: it arrives later than with the
     matched model, about 1030 s against 995 s)."""
     out = ROOT / "out" / "acceptance" / "mismatch-linear-controller"
-    r = run_master(out, "--plant", plant_fmu, "--controller", controller_fmu, "--param", "hull_model=1",
-                   "--plant-param", "hull_model=2", "--stop-time", 1500, "--quiet")
+    r = run_master(out, "--plant", plant_fmu, "--controller", controller_fmu,
+                   "--param", "mpc.hull_from_scenario=false", "--param", "mpc.hull_model=1",
+                   "--plant-param", "model.hull_from_scenario=false", "--plant-param", "model.hull=2",
+                   "--stop-time", 1500, "--quiet")
     assert r.returncode == 0, r.stdout + r.stderr
     _, d = read_csv(out / "timeseries.csv")
     scenario = tow_geometry.load_scenario(paper_scenario)

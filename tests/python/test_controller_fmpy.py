@@ -19,12 +19,19 @@ def test_model_description_capabilities(controller_fmu):
     # The solvers' warm starts are not copied or serialised: declared and refused.
     assert not cs.canGetAndSetFMUstate and not cs.canSerializeFMUstate
     names = {v.name: v for v in md.modelVariables}
-    for p in ("architecture", "avoidance_scheme", "scenario", "sample_time", "rho", "max_iterations",
-              "detection_distance", "safety_buffer", "waterway_half_width", "w_S1", "w_S2", "w_S3",
-              "w_T1", "w_T2", "w_T3", "eps_abs", "eps_rel", "altering_angle"):
+    for p in ("architecture", "avoidance_scheme", "scenario", "mpc.sample_time", "admm.rho",
+              "admm.max_iterations", "guidance.detection_distance", "guidance.safety_buffer",
+              "waterway.from_scenario", "waterway.half_width", "mpc.ship.weight_position",
+              "mpc.ship.weight_surge", "mpc.ship.weight_distance", "mpc.tug.weight_position",
+              "mpc.tug.weight_surge", "mpc.tug.weight_distance", "admm.eps_abs", "admm.eps_rel",
+              "guidance.altering_angle", "mpc.sample_time_budget"):
         assert names[p].causality == "parameter", p
     assert names["architecture"].start == "1" and names["avoidance_scheme"].start == "1"
-    assert float(names["sample_time"].start) == 1.0
+    assert float(names["mpc.sample_time"].start) == 1.0
+    # Every Real parameter declares its unit.
+    for v in md.modelVariables:
+        if v.causality == "parameter" and v.type == "Real":
+            assert v.unit, v.name
 
 
 def instantiate(controller_fmu, tmp_path, name):

@@ -14,6 +14,7 @@ struct Generated {
     xml: String,
     html: String,
     markdown: String,
+    parameters: String,
 }
 
 fn generate(fmu: &FmuCrate) -> Result<Generated> {
@@ -38,6 +39,7 @@ fn generate(fmu: &FmuCrate) -> Result<Generated> {
         xml: run_example("xml")?,
         html: run_example("html")?,
         markdown: run_example("markdown")?,
+        parameters: run_example("parameters")?,
     })
 }
 
@@ -60,7 +62,15 @@ pub fn write_model_descriptions() -> Result<()> {
         std::fs::write(&path, &generated.xml)
             .or_else(|e| fail(STEP, format!("{}: {e}", path.display())))?;
         progress(&format!("wrote {}", path.display()));
-        doc = splice(&doc, fmu.model_identifier, &generated.markdown)
+        doc = splice(&doc, fmu.model_identifier, "variables", &generated.markdown)
+            .and_then(|d| {
+                splice(
+                    &d,
+                    fmu.model_identifier,
+                    "parameters",
+                    &generated.parameters,
+                )
+            })
             .or_else(|e| fail(STEP, format!("{}: {e}", doc_path.display())))?;
     }
     std::fs::write(&doc_path, doc)
@@ -69,11 +79,11 @@ pub fn write_model_descriptions() -> Result<()> {
     Ok(())
 }
 
-/// Replaces the text between `<!-- BEGIN GENERATED: <id> variables -->` and the matching END
+/// Replaces the text between `<!-- BEGIN GENERATED: <id> <what> -->` and the matching END
 /// marker with `table`.
-fn splice(doc: &str, id: &str, table: &str) -> std::result::Result<String, String> {
-    let begin = format!("<!-- BEGIN GENERATED: {id} variables -->\n");
-    let end = format!("<!-- END GENERATED: {id} variables -->");
+fn splice(doc: &str, id: &str, what: &str, table: &str) -> std::result::Result<String, String> {
+    let begin = format!("<!-- BEGIN GENERATED: {id} {what} -->\n");
+    let end = format!("<!-- END GENERATED: {id} {what} -->");
     let a = doc
         .find(&begin)
         .ok_or_else(|| format!("marker {begin:?} not found"))?

@@ -26,7 +26,7 @@ impl Loop {
         let scenario = Scenario::paper().unwrap();
         let world = World::new(&scenario, scenario.world_config).unwrap();
         let mut config = ControllerConfig::new(scenario.clone());
-        config.architecture = architecture;
+        config.tuning.architecture = architecture;
         let controller = Controller::new(config).unwrap();
         let mut l = Loop {
             architecture,
@@ -39,15 +39,18 @@ impl Loop {
         l
     }
 
-    /// One sample and its ten communication steps; returns the sample's time.
+    /// One sample's ten communication steps through the controller's clock
+    /// ([`Controller::step`]); returns the time of the step that sampled.
     fn sample(&mut self) -> Duration {
-        let m = Measurement::from_world(&self.world);
-        let start = Instant::now();
-        self.controller.sample(&m).unwrap();
-        let spent = start.elapsed();
-        for n in 0..10 {
+        let mut spent = Duration::ZERO;
+        for _ in 0..10 {
             let m = Measurement::from_world(&self.world);
-            let c = self.controller.command_at(n as f64 * STEP, &m).unwrap();
+            let start = Instant::now();
+            let step = self.controller.step(self.world.time(), &m).unwrap();
+            if step.sample.is_some() {
+                spent = start.elapsed();
+            }
+            let c = step.command;
             self.world
                 .step(
                     &WorldInputs {

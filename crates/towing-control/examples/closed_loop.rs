@@ -122,89 +122,89 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let mut world = World::new(&scenario, scenario.world_config)?;
     let mut config = ControllerConfig::new(scenario.clone());
-    config.scheme = scheme;
+    config.tuning.scheme = scheme;
     if let Ok(g) = std::env::var("INNER_GAIN") {
         let g: f64 = g.parse()?;
-        config.inner.gain = [g, g, g];
+        config.tuning.inner.gain = [g, g, g];
     }
     let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
     if let Some(v) = env("W_F") {
-        config.ship.weight_tension = v;
+        config.tuning.ship.weight_tension = v;
     }
     if let Some(v) = env("W_A") {
-        config.ship.weight_towing_angle = v;
+        config.tuning.ship.weight_towing_angle = v;
     }
     if let Some(v) = env("F_MIN") {
-        config.ship.min_tension = v;
+        config.tuning.ship.min_tension = v;
     }
     if let Some(v) = env("ACCEPT") {
-        config.guidance.acceptance_radius = v;
+        config.tuning.guidance.acceptance_radius = v;
     }
     if let Some(v) = env("RHO") {
-        config.admm.rho = v;
+        config.tuning.admm.rho = v;
     }
     if let Some(v) = env("LOS") {
-        config.tracking.los_distance = v;
+        config.tuning.tracking.los_distance = v;
     }
     if let Some(v) = env("LOOKAHEAD") {
-        config.tracking.lookahead = v;
+        config.tuning.tracking.lookahead = v;
     }
     if let Some(v) = env("W_S1") {
-        config.ship.weight_position = v;
-        config.ship.weight_heading = v;
+        config.tuning.ship.weight_position = v;
+        config.tuning.ship.weight_heading = v;
     }
     if let Some(v) = env("W_S2") {
-        config.ship.weight_surge = v;
-        config.ship.weight_sway = v;
+        config.tuning.ship.weight_surge = v;
+        config.tuning.ship.weight_sway = v;
     }
     if let Some(v) = env("W_T2") {
-        config.tug.weight_surge = v;
-        config.tug.weight_sway = v;
-        config.tug.weight_yaw_rate = v;
+        config.tuning.tug.weight_surge = v;
+        config.tuning.tug.weight_sway = v;
+        config.tuning.tug.weight_yaw_rate = v;
     }
     if let Some(v) = env("W_R") {
-        config.ship.weight_yaw_rate = v;
+        config.tuning.ship.weight_yaw_rate = v;
     }
     if let Some(v) = env("ARCH") {
-        config.architecture = towing_control::Architecture::from_code(v as i32)?;
+        config.tuning.architecture = towing_control::Architecture::from_code(v as i32)?;
     }
     if let Some(v) = env("EPS") {
-        config.ship.distance.epsilon = v;
-        config.tug.distance.epsilon = v;
+        config.tuning.ship.distance.epsilon = v;
+        config.tuning.tug.distance.epsilon = v;
     }
     if let Some(v) = env("CENT_TOL") {
-        config.centralized.tolerance = v;
+        config.tuning.centralized.tolerance = v;
     }
     if let Some(v) = env("CENT_GOOD") {
-        config.centralized.scp.good = v;
+        config.tuning.centralized.scp.good = v;
     }
     if let Some(v) = env("CENT_POOR") {
-        config.centralized.scp.poor = v;
+        config.tuning.centralized.scp.poor = v;
     }
     if let Some(v) = env("GW_LA") {
-        config.tracking.give_way_lookahead = v;
+        config.tuning.tracking.give_way_lookahead = v;
     }
     if let Some(v) = env("TUG_NMAX") {
-        config.tug.thrust_limit[2] = v;
+        config.tuning.tug.thrust_limit[2] = v;
     }
     if let Some(v) = env("TUG_TR_N") {
-        config.tug.trust_scale[2] = v;
+        config.tuning.tug.trust_scale[2] = v;
     }
     if let Some(v) = env("PT_W") {
-        config.ship.weight_port_turn = v;
+        config.tuning.ship.weight_port_turn = v;
     }
     if let Some(v) = env("PT_M") {
-        config.tracking.port_turn_margin = v.to_radians();
+        config.tuning.tracking.port_turn_margin = v.to_radians();
     }
     if let Some(v) = env("TUG_RW") {
-        config.centralized.weight_force_rate = v;
-        config.centralized.weight_moment_rate = v;
+        config.tuning.centralized.weight_force_rate = v;
+        config.tuning.centralized.weight_moment_rate = v;
     }
     if let Some(v) = env("CENT_IT") {
-        config.centralized.max_iterations = v as usize;
+        config.tuning.centralized.max_iterations = v as usize;
     }
     if let (Some(w), Some(t)) = (env("TERM_W"), env("TERM_T")) {
-        config.ship.terminal = Some(towing_mpc::TerminalCost {
+        config.tuning.ship.terminal = Some(towing_mpc::TerminalCost {
             weight: w,
             horizon: t,
         });
@@ -230,8 +230,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let wall = std::time::Instant::now();
     for n in 0..steps {
         let m = Measurement::from_world(&world);
-        if n % per_sample == 0 {
-            let r = controller.sample(&m)?;
+        let step = controller.step(world.time(), &m)?;
+        if let Some(r) = step.sample {
             times.push(r.compute_time * 1e3);
             iters.push(r.iterations);
             not_converged += usize::from(!r.converged);
@@ -269,7 +269,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 eprintln!("t = {:.1}: fallback: {why}", world.time());
             }
         }
-        let c = controller.command_at((n % per_sample) as f64 * h, &m)?;
+        let c = step.command;
         world.step(
             &WorldInputs {
                 tug_tau: c.tug_thrust,

@@ -1,13 +1,18 @@
-//! Controller configuration: architecture, avoidance scheme, sample time and
-//! every tuning value, with the defaults of `docs/assumptions.md`.
+//! Controller configuration: the scenario, every tuning value ([`Tuning`], the
+//! values of the parameter registry [`crate::params`], with the defaults of
+//! `docs/assumptions.md`) and, from Rust only, user hulls for the prediction
+//! models ([`PredictionHulls`]).
+
+use std::sync::Arc;
 
 use towing_guidance::{GuidanceParams, GuidanceSettings, Route};
-use towing_model::{HullModel, Scenario};
+use towing_model::{HullDynamics, HullModel, Scenario};
 use towing_mpc::{
     AdmmSettings, CentralizedSettings, PredictionParams, ShipMpcParams, TugMpcParams,
 };
 
 use crate::error::ConfigError;
+use crate::params;
 
 /// Which optimisation computes the commands (FMI parameter `architecture`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -147,7 +152,7 @@ pub struct TrackingParams {
     /// Rules 15 and 17(c)) and the scheme alters waypoints (I, II), the ship's
     /// predicted heading is kept to starboard of its heading at the start of
     /// the encounter minus this margin
-    /// ([`towing_mpc::ShipMpcParams::port_turn_weight`]).
+    /// ([`towing_mpc::ShipMpcParams::weight_port_turn`]).
     pub port_turn_margin: f64,
 }
 
@@ -166,20 +171,48 @@ impl Default for TrackingParams {
     }
 }
 
-/// Everything the controller needs; [`ControllerConfig::new`] gives the
-/// documented defaults for a scenario.
-#[derive(Debug, Clone)]
-pub struct ControllerConfig {
-    /// Vessels (prediction models), formation, route and waterway.
-    pub scenario: Scenario,
-    /// The prediction models' hull.
-    pub hull: HullModel,
+/// Where the waterway's half width comes from (the reference system's `d_2`,
+/// `docs/colregs.md`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WaterwaySettings {
+    /// Take the scenario's `[waterway] half_width` (none without that section).
+    pub from_scenario: bool,
+    /// The half width (m, > 0) when not from the scenario.
+    pub half_width: f64,
+}
+
+impl Default for WaterwaySettings {
+    /// From the scenario; 5 m (the paper scenario's) otherwise.
+    fn default() -> Self {
+        WaterwaySettings {
+            from_scenario: true,
+            half_width: 5.0,
+        }
+    }
+}
+
+/// Every tuning value of the controller: the values of the parameter registry
+/// ([`crate::params::PARAMETERS`], one FMI parameter each), independent of the
+/// scenario. [`Tuning::default`] holds the documented defaults.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tuning {
     /// Distributed or centralized.
     pub architecture: Architecture,
     /// Scheme I, II or III.
     pub scheme: AvoidanceScheme,
+    /// The prediction models' hull as the scenario's `[simulation]` says
+    /// (`true`) or [`Tuning::hull`].
+    pub hull_from_scenario: bool,
+    /// The prediction models' hull when not from the scenario.
+    pub hull: HullModel,
     /// Sample time `T_s` and RK4 substep of the predictions.
     pub prediction: PredictionParams,
+    /// Wall-clock budget of one control sample (s; 0: none). When set, the
+    /// optimisation stops iterating once the budget is spent (after at least one
+    /// ADMM iteration or SCP step) and applies the best iterate so far, which
+    /// satisfies every bound; the report says so (`budget_hit`). A budget makes
+    /// the run depend on the machine's speed; 0 keeps it deterministic.
+    pub sample_time_budget: f64,
     /// ADMM penalty, iterations, tolerances.
     pub admm: AdmmSettings,
     /// The centralized problem's SCP loop.
@@ -188,46 +221,135 @@ pub struct ControllerConfig {
     pub ship: ShipMpcParams,
     /// Tug problems (Table 3 weights, thrust bounds).
     pub tug: TugMpcParams,
-    /// Reference system (`d_D`, `theta`, `d_S0`, waterway).
+    /// Reference system (`d_D`, `theta`, `d_S0`); its waterway and vessel
+    /// lengths are set from [`Tuning::waterway`] and the scenario when built.
     pub guidance: GuidanceSettings,
+    /// The waterway's half width.
+    pub waterway: WaterwaySettings,
     /// The tugs' inner loop.
     pub inner: InnerLoopParams,
     /// How the MPC tracks the reference system's output.
     pub tracking: TrackingParams,
-    /// Wall-clock budget of one control sample (s; 0: none). When set, the
-    /// optimisation stops iterating once the budget is spent (after at least one
-    /// ADMM iteration or SCP step) and applies the best iterate so far, which
-    /// satisfies every bound; the report says so (`budget_hit`). A budget makes
-    /// the run depend on the machine's speed; 0 keeps it deterministic.
-    pub sample_time_budget: f64,
 }
 
-impl ControllerConfig {
-    /// The defaults for `scenario`: hull as the scenario's `[simulation]` says,
-    /// distributed, scheme I, `T_s = 1 s`, and the guidance's waterway half width
-    /// and vessel lengths from the scenario.
-    #[must_use]
-    pub fn new(scenario: Scenario) -> ControllerConfig {
-        let guidance = GuidanceSettings {
-            waterway_half_width: scenario.waterway.as_ref().map(|w| w.half_width),
-            ship_length: scenario.ship_data.length,
-            tug_length: scenario.tug_data[0].length.max(scenario.tug_data[1].length),
-            ..GuidanceSettings::default()
-        };
-        ControllerConfig {
-            hull: scenario.world_config.hull_model,
-            scenario,
+impl Default for Tuning {
+    fn default() -> Self {
+        Tuning {
             architecture: Architecture::default(),
             scheme: AvoidanceScheme::default(),
+            hull_from_scenario: true,
+            hull: HullModel::default(),
             prediction: PredictionParams::default(),
+            sample_time_budget: 0.0,
             admm: AdmmSettings::default(),
             centralized: CentralizedSettings::default(),
             ship: ShipMpcParams::default(),
             tug: TugMpcParams::default(),
-            guidance,
+            guidance: GuidanceSettings::default(),
+            waterway: WaterwaySettings::default(),
             inner: InnerLoopParams::default(),
             tracking: TrackingParams::default(),
-            sample_time_budget: 0.0,
+        }
+    }
+}
+
+impl Tuning {
+    /// Checks every value: each registry parameter against its range
+    /// ([`params::Parameter::check`]), then the rules between parameters
+    /// ([`params::check_relations`]). The FMU checks the same, with the same
+    /// messages.
+    ///
+    /// # Errors
+    /// The first value refused, by its parameter name, with the reason.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        for p in params::PARAMETERS {
+            p.check(&p.get(self))?;
+        }
+        params::check_relations(self)
+    }
+}
+
+/// The prediction models' hulls given from Rust (not expressible as FMI
+/// parameters): the ship's and each tug's [`HullDynamics`], e.g. the hulls of a
+/// higher-fidelity plant (`docs/swap-plant.md`). Their `d nu_dot / d nu` is taken
+/// by finite differences ([`towing_mpc::PredictionHull::custom`]).
+#[derive(Debug, Clone)]
+pub struct PredictionHulls {
+    /// The ship's hull.
+    pub ship: Arc<dyn HullDynamics>,
+    /// Tug 1's and tug 2's hulls.
+    pub tugs: [Arc<dyn HullDynamics>; 2],
+}
+
+/// Everything the controller needs; [`ControllerConfig::new`] gives the
+/// documented defaults for a scenario.
+#[derive(Debug, Clone)]
+pub struct ControllerConfig {
+    /// Vessels (prediction models), formation, route and waterway.
+    pub scenario: Scenario,
+    /// Every tuning value.
+    pub tuning: Tuning,
+    /// User hulls for the prediction models; `None`: the built-in hull of
+    /// [`Tuning::hull`] (or the scenario's).
+    pub hulls: Option<PredictionHulls>,
+}
+
+impl ControllerConfig {
+    /// The defaults for `scenario` (distributed, scheme I, `T_s = 1 s`, hull and
+    /// waterway as the scenario says).
+    #[must_use]
+    pub fn new(scenario: Scenario) -> ControllerConfig {
+        ControllerConfig::with_tuning(scenario, Tuning::default())
+    }
+
+    /// `scenario` with the given tuning values (checked by
+    /// [`ControllerConfig::validate`] and [`crate::Controller::new`]).
+    #[must_use]
+    pub fn with_tuning(scenario: Scenario, tuning: Tuning) -> ControllerConfig {
+        ControllerConfig {
+            scenario,
+            tuning,
+            hulls: None,
+        }
+    }
+
+    /// Sets the parameter `name` of the registry ([`crate::params`]) to `value`,
+    /// checked against its range.
+    ///
+    /// # Errors
+    /// An unknown name, a value of the wrong type or out of range.
+    pub fn set(&mut self, name: &str, value: params::Value) -> Result<(), ConfigError> {
+        let p = params::find(name).ok_or_else(|| ConfigError::UnknownParameter {
+            name: name.to_owned(),
+        })?;
+        p.check(&value)?;
+        Ok(p.set(&mut self.tuning, value)?)
+    }
+
+    /// The prediction models' built-in hull (the scenario's or the tuning's).
+    #[must_use]
+    pub fn hull(&self) -> HullModel {
+        if self.tuning.hull_from_scenario {
+            self.scenario.world_config.hull_model
+        } else {
+            self.tuning.hull
+        }
+    }
+
+    /// The reference system's settings: the tuning's, with the waterway and the
+    /// vessel lengths of the scenario.
+    #[must_use]
+    pub fn guidance(&self) -> GuidanceSettings {
+        let s = &self.scenario;
+        GuidanceSettings {
+            waterway_half_width: if self.tuning.waterway.from_scenario {
+                s.waterway.as_ref().map(|w| w.half_width)
+            } else {
+                Some(self.tuning.waterway.half_width)
+            },
+            ship_length: s.ship_data.length,
+            tug_length: s.tug_data[0].length.max(s.tug_data[1].length),
+            ..self.tuning.guidance
         }
     }
 
@@ -237,53 +359,17 @@ impl ControllerConfig {
     /// A route the reference system refuses (e.g. repeated points).
     pub fn route(&self) -> Result<Route, ConfigError> {
         let points = self.scenario.route.points().copied().collect();
-        Route::new(points).map_err(|e| ConfigError::new("scenario.route", e.to_string()))
+        Route::new(points).map_err(|source| ConfigError::Route { source })
     }
 
-    /// Checks every value.
+    /// Checks every value: the tuning ([`Tuning::validate`]), the reference
+    /// system's settings with the scenario's values, the route.
     ///
     /// # Errors
-    /// The first value out of range, named.
+    /// The first value refused, named.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        self.prediction
-            .validate()
-            .map_err(|e| ConfigError::new(&e.field, e.reason))?;
-        self.admm
-            .validate()
-            .map_err(|e| ConfigError::new(&e.field, e.reason))?;
-        GuidanceParams::new(self.guidance)
-            .map_err(|e| ConfigError::new("guidance", e.to_string()))?;
-        for (axis, g) in ["surge", "sway", "yaw"].iter().zip(self.inner.gain) {
-            if !(g.is_finite() && g >= 0.0) {
-                return Err(ConfigError::new(
-                    &format!("inner_loop_gain_{axis}"),
-                    format!("must be finite and >= 0, got {g}"),
-                ));
-            }
-        }
-        for (name, v) in [
-            ("lookahead", self.tracking.lookahead),
-            ("give_way_lookahead", self.tracking.give_way_lookahead),
-            ("los_distance", self.tracking.los_distance),
-            ("port_turn_margin", self.tracking.port_turn_margin),
-            ("port_turn_weight", self.ship.weight_port_turn),
-            ("sample_time_budget", self.sample_time_budget),
-            (
-                "centralized_force_rate_weight",
-                self.centralized.weight_force_rate,
-            ),
-            (
-                "centralized_moment_rate_weight",
-                self.centralized.weight_moment_rate,
-            ),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(ConfigError::new(
-                    name,
-                    format!("must be finite and >= 0, got {v}"),
-                ));
-            }
-        }
+        self.tuning.validate()?;
+        GuidanceParams::new(self.guidance()).map_err(|source| ConfigError::Guidance { source })?;
         self.route()?;
         Ok(())
     }

@@ -32,8 +32,9 @@ use towing_model::{
     wrap_angle, ObstacleKind, ObstacleSlot, Pose, VesselData, VesselState, World, MAX_OBSTACLES,
 };
 use towing_mpc::{
-    Admm, AppliedCommand, Budget, Centralized, Obstacle, Optimizer, QpOutcome, SampleInput,
-    ShipInput, ShipModel, TugInput, HORIZON,
+    Admm, AdmmBuildError, AppliedCommand, Budget, Centralized, FormationMap, Obstacle, Optimizer,
+    PredictionHull, QpOutcome, SampleInput, ShipInput, ShipModel, ShipMpc, TugInput, TugModel,
+    TugMpc, HORIZON,
 };
 
 use crate::config::{Architecture, ControllerConfig, InnerLoopParams};
@@ -136,11 +137,11 @@ pub struct SampleReport {
     pub guidance: GuidanceOutput,
     /// The reference the MPC tracked (`eta_Sd`, or the route waypoint in scheme III).
     pub reference: [f64; 3],
-    /// COLREGS situation code per obstacle slot (`Situation::code`; -1: static
-    /// hazard or empty slot).
-    pub situation: [i32; MAX_OBSTACLES],
-    /// The tow's role per slot: 1 give-way, 2 stand-on, 0 none.
-    pub role: [i32; MAX_OBSTACLES],
+    /// COLREGS situation per obstacle slot (`None`: static hazard or empty
+    /// slot).
+    pub situation: [Option<Situation>; MAX_OBSTACLES],
+    /// The tow's role per slot (`None`: none).
+    pub role: [Option<Role>; MAX_OBSTACLES],
     /// ADMM iterations (1 for the centralized problem's single SCP loop count).
     pub iterations: usize,
     /// Whether eq. (29) stopped the ADMM (the centralized problem: its
@@ -165,6 +166,62 @@ pub struct SampleReport {
     pub heading_floor: Option<f64>,
     /// Predicted trajectories of the plan.
     pub prediction: Prediction,
+}
+
+/// The reference system's part of a sample.
+struct Guided {
+    output: GuidanceOutput,
+    reference: [f64; 3],
+    situation: [Option<Situation>; MAX_OBSTACLES],
+    role: [Option<Role>; MAX_OBSTACLES],
+    heading_floor: Option<f64>,
+}
+
+/// What one [`Controller::step`] did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Step {
+    /// The command for the communication step.
+    pub command: Command,
+    /// The control sample run at its start, if one was due.
+    pub sample: Option<SampleReport>,
+}
+
+/// A step refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StepError {
+    /// The control sample refused its measurement.
+    #[error("sample at t = {t} s refused: {source}")]
+    Sample {
+        /// The step's time (s).
+        t: f64,
+        /// Why.
+        #[source]
+        source: MeasurementError,
+    },
+    /// The inner loop refused its measurement.
+    #[error("command at t = {t} s refused: {source}")]
+    Command {
+        /// The step's time (s).
+        t: f64,
+        /// Why.
+        #[source]
+        source: MeasurementError,
+    },
+}
+
+/// A communication point within this of a sample instant samples (1 us).
+pub const SAMPLE_TOLERANCE: Duration = Duration::from_micros(1);
+const SAMPLE_TOLERANCE_NS: i64 = 1_000;
+
+/// The sampling clock of [`Controller::step`], in whole nanoseconds since the
+/// start time.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Clock {
+    start: Option<f64>,
+    sample_ns: i64,
+    next_ns: i64,
+    last_ns: i64,
+    samples: u64,
 }
 
 /// Why a sample applied the fallback plan.
@@ -215,6 +272,7 @@ pub struct Controller {
     /// Per obstacle slot: the ship's heading when an encounter began in which
     /// the tow may not turn to port ([`TrackingParams::port_turn_margin`]).
     port_turn_anchor: [Option<f64>; MAX_OBSTACLES],
+    clock: Clock,
 }
 
 fn mass_matrix(d: &VesselData) -> [[f64; 3]; 3] {
@@ -237,12 +295,12 @@ impl Controller {
         config.validate()?;
         let guidance = ReferenceSystem::new(
             config.route()?,
-            GuidanceParams::new(config.guidance)
+            GuidanceParams::new(config.guidance())
                 .map_err(|e| ConfigError::new("guidance", e.to_string()))?,
         );
-        let mut ship_params = config.ship;
-        let mut tug_params = config.tug;
-        if !config.scheme.distance_cost() {
+        let mut ship_params = config.tuning.ship;
+        let mut tug_params = config.tuning.tug;
+        if !config.tuning.scheme.distance_cost() {
             ship_params.weight_distance = 0.0;
             tug_params.weight_distance = 0.0;
         }
@@ -250,7 +308,7 @@ impl Controller {
         let s = &config.scenario;
         let inner_k = std::array::from_fn(|i| {
             let m = mass_matrix(&s.tug_data[i]);
-            std::array::from_fn(|r| std::array::from_fn(|c| config.inner.gain[r] * m[r][c]))
+            std::array::from_fn(|r| std::array::from_fn(|c| config.tuning.inner.gain[r] * m[r][c]))
         });
         let thrust_limit = std::array::from_fn(|i| {
             let d = &s.tug_data[i];
@@ -261,7 +319,8 @@ impl Controller {
                 l[2].min(d.max_yaw_moment),
             ]
         });
-        let f0 = config.ship.min_tension;
+        let f0 = config.tuning.ship.min_tension;
+        let sample_time = config.tuning.prediction.sample_time;
         Ok(Controller {
             config,
             guidance,
@@ -284,6 +343,11 @@ impl Controller {
                 radius: 1.0,
             }; MAX_OBSTACLES],
             port_turn_anchor: [None; MAX_OBSTACLES],
+            clock: Clock {
+                // sample_time > 0 and finite (checked); at least 1 ns.
+                sample_ns: ((sample_time * 1e9).round() as i64).max(1),
+                ..Clock::default()
+            },
         })
     }
 
@@ -312,104 +376,23 @@ impl Controller {
     pub fn sample(&mut self, m: &Measurement) -> Result<SampleReport, MeasurementError> {
         let start = Instant::now();
         m.validate()?;
-        let tow = m.tow_state();
-        let guidance =
-            self.guidance
-                .update(&tow, &m.obstacles)
-                .map_err(|e| MeasurementError::Obstacle {
-                    slot: 0,
-                    reason: e.to_string(),
-                })?;
-        let target = if self.config.scheme.alters() {
-            guidance.eta_sd
-        } else {
-            guidance.route_waypoint
-        };
-        let altered = guidance.altered && self.config.scheme.alters();
-        // Rule 8(e) and 16: give way in a crossing also by slackening speed (the
-        // tracked point comes nearer), so the target can pass ahead.
-        let giving_way = altered
-            && guidance
-                .governing
-                .is_some_and(|g| g.situation == Some(Situation::CrossingGiveWay));
-        let lookahead = if giving_way {
-            self.config.tracking.give_way_lookahead
-        } else {
-            self.config.tracking.lookahead
-        };
-        let reference = self.reference(
-            &m.ship,
-            guidance.active_waypoint,
-            target,
-            altered,
-            lookahead,
-        );
-        let mut situation = [-1; MAX_OBSTACLES];
-        let mut roles = [0; MAX_OBSTACLES];
-        let status = self.config.guidance.colregs.tow_status;
-        for k in 0..MAX_OBSTACLES {
-            if let Some(s) = self.guidance.situation(k) {
-                situation[k] = s.code();
-                roles[k] = match role(s, status) {
-                    Some(Role::GiveWay) => 1,
-                    Some(Role::StandOn) => 2,
-                    None => 0,
-                };
-            }
-        }
-        let heading_floor = self.heading_floor(m.ship[2]);
+        let guided = self.guide(m)?;
         let n_obstacles = self.select_obstacles(m);
         let input = SampleInput {
             ship: m.ship,
             tugs: m.tugs,
             previous: self.applied,
-            reference: [reference; HORIZON],
+            reference: [guided.reference; HORIZON],
             obstacles: &self.mpc_obstacles[..n_obstacles],
-            heading_floor,
+            heading_floor: guided.heading_floor,
         };
+        let budget_s = self.config.tuning.sample_time_budget;
         let budget = Budget::from(
             start,
-            (self.config.sample_time_budget > 0.0)
-                .then(|| Duration::from_secs_f64(self.config.sample_time_budget)),
+            (budget_s > 0.0).then(|| Duration::from_secs_f64(budget_s)),
         );
         let report = self.solver.solve(&input, budget);
-        let ship_plan = self.solver.ship_plan();
-        let tug_plans = [self.solver.tug_plan(0), self.solver.tug_plan(1)];
-        let finite = ship_plan.iter().flatten().all(|v| v.is_finite())
-            && tug_plans.iter().flatten().flatten().all(|v| v.is_finite());
-        let fallback = if let Some((problem, outcome)) = report.failed {
-            Some(Fallback::SolveFailed { problem, outcome })
-        } else if !finite {
-            Some(Fallback::NonFinitePlan)
-        } else {
-            None
-        };
-        let (ship_cmd, tug_cmd) = if fallback.is_some() {
-            self.fallbacks += 1;
-            let (s, t) = self.fallback_command();
-            self.solver.reset();
-            (s, t)
-        } else {
-            (ship_plan[0], [tug_plans[0][0], tug_plans[1][0]])
-        };
-        // The next sample's spare plan, and the warm start.
-        if fallback.is_none() {
-            let shift = |h: usize| (h + 1).min(HORIZON - 1);
-            self.spare_ship = std::array::from_fn(|h| ship_plan[shift(h)]);
-            self.spare_tugs =
-                std::array::from_fn(|i| std::array::from_fn(|h| tug_plans[i][shift(h)]));
-            self.spare_left = HORIZON - 1;
-            self.solver.shift();
-        } else {
-            let shift = |h: usize| (h + 1).min(HORIZON - 1);
-            self.spare_ship = std::array::from_fn(|h| self.spare_ship[shift(h)]);
-            self.spare_tugs =
-                std::array::from_fn(|i| std::array::from_fn(|h| self.spare_tugs[i][shift(h)]));
-        }
-        self.applied = AppliedCommand {
-            ship: ship_cmd,
-            tugs: tug_cmd,
-        };
+        let (ship_cmd, tug_cmd, fallback) = self.apply(report.failed);
         let prediction = self.prediction(m, fallback.is_none());
         for i in 0..2 {
             self.nu_start[i] = [m.tugs[i][3], m.tugs[i][4], m.tugs[i][5]];
@@ -425,10 +408,10 @@ impl Controller {
                 tension: [ship_cmd[0], ship_cmd[1]],
             },
             desired_angle: [ship_cmd[2], ship_cmd[3]],
-            guidance,
-            reference,
-            situation,
-            role: roles,
+            guidance: guided.output,
+            reference: guided.reference,
+            situation: guided.situation,
+            role: guided.role,
             iterations: report.iterations,
             converged: report.converged,
             budget_hit: report.budget_hit,
@@ -437,9 +420,144 @@ impl Controller {
             compute_time: start.elapsed().as_secs_f64(),
             fallback,
             fallbacks: self.fallbacks,
-            heading_floor,
+            heading_floor: guided.heading_floor,
             prediction,
         })
+    }
+
+    /// The reference system's part of a sample: the reference to track, the
+    /// COLREGS situations and roles, the heading floor.
+    fn guide(&mut self, m: &Measurement) -> Result<Guided, MeasurementError> {
+        let guidance = self
+            .guidance
+            .update(&m.tow_state(), &m.obstacles)
+            .map_err(|e| MeasurementError::Obstacle {
+                slot: 0,
+                reason: e.to_string(),
+            })?;
+        let t = &self.config.tuning;
+        let target = if t.scheme.alters() {
+            guidance.eta_sd
+        } else {
+            guidance.route_waypoint
+        };
+        let altered = guidance.altered && t.scheme.alters();
+        // Rule 8(e) and 16: give way in a crossing also by slackening speed (the
+        // tracked point comes nearer), so the target can pass ahead.
+        let giving_way = altered
+            && guidance
+                .governing
+                .is_some_and(|g| g.situation == Some(Situation::CrossingGiveWay));
+        let lookahead = if giving_way {
+            t.tracking.give_way_lookahead
+        } else {
+            t.tracking.lookahead
+        };
+        let status = t.guidance.colregs.tow_status;
+        let reference = self.reference(
+            &m.ship,
+            guidance.active_waypoint,
+            target,
+            altered,
+            lookahead,
+        );
+        let situation: [Option<Situation>; MAX_OBSTACLES] =
+            std::array::from_fn(|k| self.guidance.situation(k));
+        Ok(Guided {
+            output: guidance,
+            reference,
+            situation,
+            role: situation.map(|s| s.and_then(|s| role(s, status))),
+            heading_floor: self.heading_floor(m.ship[2]),
+        })
+    }
+
+    /// The command of a solved sample (the plan's first move), or the fallback
+    /// if a subproblem failed or the plan is not finite; keeps the next
+    /// sample's spare plan and warm start, and records the applied command.
+    fn apply(
+        &mut self,
+        failed: Option<(&'static str, QpOutcome)>,
+    ) -> (ShipInput, [TugInput; 2], Option<Fallback>) {
+        let ship_plan = self.solver.ship_plan();
+        let tug_plans = [self.solver.tug_plan(0), self.solver.tug_plan(1)];
+        let finite = ship_plan.iter().flatten().all(|v| v.is_finite())
+            && tug_plans.iter().flatten().flatten().all(|v| v.is_finite());
+        let fallback = if let Some((problem, outcome)) = failed {
+            Some(Fallback::SolveFailed { problem, outcome })
+        } else if !finite {
+            Some(Fallback::NonFinitePlan)
+        } else {
+            None
+        };
+        let shift = |h: usize| (h + 1).min(HORIZON - 1);
+        let (ship_cmd, tug_cmd) = if fallback.is_some() {
+            self.fallbacks += 1;
+            let (s, t) = self.fallback_command();
+            self.solver.reset();
+            self.spare_ship = std::array::from_fn(|h| self.spare_ship[shift(h)]);
+            self.spare_tugs =
+                std::array::from_fn(|i| std::array::from_fn(|h| self.spare_tugs[i][shift(h)]));
+            (s, t)
+        } else {
+            // The next sample's spare plan, and the warm start.
+            self.spare_ship = std::array::from_fn(|h| ship_plan[shift(h)]);
+            self.spare_tugs =
+                std::array::from_fn(|i| std::array::from_fn(|h| tug_plans[i][shift(h)]));
+            self.spare_left = HORIZON - 1;
+            self.solver.shift();
+            (ship_plan[0], [tug_plans[0][0], tug_plans[1][0]])
+        };
+        self.applied = AppliedCommand {
+            ship: ship_cmd,
+            tugs: tug_cmd,
+        };
+        (ship_cmd, tug_cmd, fallback)
+    }
+
+    /// The command for the communication step starting at `t` (s), owning the
+    /// sampling clock: a control sample ([`Controller::sample`]) runs first when
+    /// `t` has reached the next sample instant `t_0 + k T_s` (within
+    /// [`SAMPLE_TOLERANCE`], on a nanosecond clock, `t_0` the time of the first
+    /// step or [`Controller::set_start_time`]); then the command is
+    /// [`Controller::command_at`] the time since that sample. The FMU, the
+    /// examples and the benchmarks all step through this.
+    ///
+    /// # Errors
+    /// A refused measurement (the sample's or the inner loop's); nothing changes
+    /// then.
+    pub fn step(&mut self, t: f64, m: &Measurement) -> Result<Step, StepError> {
+        let start = *self.clock.start.get_or_insert(t);
+        let now_ns = ((t - start) * 1e9).round() as i64;
+        let mut sample = None;
+        if now_ns + SAMPLE_TOLERANCE_NS >= self.clock.next_ns {
+            let report = self
+                .sample(m)
+                .map_err(|source| StepError::Sample { t, source })?;
+            self.clock.last_ns = now_ns;
+            while self.clock.next_ns <= now_ns + SAMPLE_TOLERANCE_NS {
+                self.clock.next_ns += self.clock.sample_ns;
+            }
+            self.clock.samples += 1;
+            sample = Some(report);
+        }
+        let elapsed = (now_ns - self.clock.last_ns) as f64 * 1e-9;
+        let command = self
+            .command_at(elapsed, m)
+            .map_err(|source| StepError::Command { t, source })?;
+        Ok(Step { command, sample })
+    }
+
+    /// Sets the time of the first sample instant (s); by default the time of
+    /// the first [`Controller::step`].
+    pub fn set_start_time(&mut self, t0: f64) {
+        self.clock.start = Some(t0);
+    }
+
+    /// Control samples run by [`Controller::step`] so far.
+    #[must_use]
+    pub fn samples(&self) -> u64 {
+        self.clock.samples
     }
 
     /// The command at `elapsed` seconds after the last sample, with the tugs'
@@ -448,7 +566,7 @@ impl Controller {
     /// # Errors
     /// A non-finite tug velocity, by name.
     pub fn command_at(&self, elapsed: f64, m: &Measurement) -> Result<Command, MeasurementError> {
-        let s = (elapsed / self.config.prediction.sample_time).clamp(0.0, 1.0);
+        let s = (elapsed / self.config.tuning.prediction.sample_time).clamp(0.0, 1.0);
         let mut tug_thrust = self.applied.tugs;
         for i in 0..2 {
             for c in 0..3 {
@@ -499,7 +617,7 @@ impl Controller {
         let points = self.guidance.route().points();
         let last = points.len() - 1;
         let mut goal = target.eta();
-        if self.config.tracking.lookahead > 0.0 {
+        if self.config.tuning.tracking.lookahead > 0.0 {
             let prev = points[active - 1];
             let seg = [target.x - prev.x, target.y - prev.y];
             let len = seg[0].hypot(seg[1]);
@@ -526,7 +644,7 @@ impl Controller {
             }
         }
         let (dx, dy) = (goal[0] - ship[0], goal[1] - ship[1]);
-        let los = self.config.tracking.los_distance;
+        let los = self.config.tuning.tracking.los_distance;
         if los > 0.0 && dx.hypot(dy) > los {
             goal[2] = dy.atan2(dx);
         }
@@ -548,7 +666,7 @@ impl Controller {
     /// to target A (`docs/controller-design.md`). Scheme III (distance cost
     /// only, no COLREGS logic) has no floor, as in the paper.
     fn heading_floor(&mut self, psi: f64) -> Option<f64> {
-        let alters = self.config.scheme.alters();
+        let alters = self.config.tuning.scheme.alters();
         let mut floor: Option<f64> = None;
         for k in 0..MAX_OBSTACLES {
             let binding = alters
@@ -570,7 +688,7 @@ impl Controller {
             };
             self.port_turn_anchor[k] = Some(anchor);
             // Relative to the current heading, so that wrapping cannot matter.
-            let limit = wrap_angle(anchor - psi) - self.config.tracking.port_turn_margin;
+            let limit = wrap_angle(anchor - psi) - self.config.tuning.tracking.port_turn_margin;
             floor = Some(floor.map_or(limit, |f: f64| f.max(limit)));
         }
         floor.map(|f| psi + f)
@@ -579,7 +697,7 @@ impl Controller {
     /// The inner loop's parameters.
     #[must_use]
     pub fn inner_loop(&self) -> InnerLoopParams {
-        self.config.inner
+        self.config.tuning.inner
     }
 
     /// The spare plan's first sample, within the bounds and rate bounds of the
@@ -587,8 +705,8 @@ impl Controller {
     /// command goes to rest: the tensions to the pretension and the angles to
     /// zero at their rate bounds, no thrust; the tow then drifts to a stop.
     fn fallback_command(&mut self) -> (ShipInput, [TugInput; 2]) {
-        let p = &self.config.ship;
-        let ts = self.config.prediction.sample_time;
+        let p = &self.config.tuning.ship;
+        let ts = self.config.tuning.prediction.sample_time;
         let (tension_step, angle_step) = (p.tension_rate * ts, p.angle_rate * ts);
         let prev = self.applied.ship;
         let have_spare = self.spare_left > 0;
@@ -624,18 +742,18 @@ impl Controller {
     /// Copies the nearest obstacles (by range from the tow) into the MPC's list;
     /// returns how many.
     fn select_obstacles(&mut self, m: &Measurement) -> usize {
-        let slots = self
-            .config
+        let t = &self.config.tuning;
+        let slots = t
             .ship
             .clearance
             .max_obstacles
-            .min(self.config.tug.clearance.max_obstacles);
+            .min(t.tug.clearance.max_obstacles);
         let points = [
             [m.ship[0], m.ship[1]],
             [m.tugs[0][0], m.tugs[0][1]],
             [m.tugs[1][0], m.tugs[1][1]],
         ];
-        let ts = self.config.prediction.sample_time;
+        let ts = self.config.tuning.prediction.sample_time;
         let mut candidates: [(f64, usize); MAX_OBSTACLES] = [(f64::INFINITY, 0); MAX_OBSTACLES];
         let mut n = 0;
         for (k, o) in m.obstacles.iter().enumerate() {
@@ -709,34 +827,84 @@ fn mpc_obstacle(o: &ObstacleSlot, sample_time: f64) -> Obstacle {
     }
 }
 
-/// The optimizer of the configured architecture.
+/// The optimizer of the configured architecture, on prediction models with the
+/// configured hulls.
 fn build_optimizer(
     config: &ControllerConfig,
     ship_params: towing_mpc::ShipMpcParams,
     tug_params: towing_mpc::TugMpcParams,
 ) -> Result<Box<dyn Optimizer>, ConfigError> {
-    Ok(match config.architecture {
-        Architecture::Distributed => Box::new(
-            Admm::from_scenario_with(
-                &config.scenario,
-                config.hull,
-                config.prediction,
-                ship_params,
-                tug_params,
-                config.admm,
+    let t = &config.tuning;
+    let architecture = match t.architecture {
+        Architecture::Distributed => "distributed",
+        Architecture::Centralized => "centralized",
+    };
+    let mpc = |source| ConfigError::Mpc {
+        architecture,
+        source,
+    };
+    let (ship, tugs, formation) = prediction_models(config).map_err(mpc)?;
+    Ok(match t.architecture {
+        Architecture::Distributed => {
+            let tug = |model| TugMpc::new(model, tug_params).map_err(AdmmBuildError::from);
+            let [t1, t2] = tugs;
+            Box::new(
+                Admm::new(
+                    ShipMpc::new(ship, formation, ship_params).map_err(|e| mpc(e.into()))?,
+                    [tug(t1).map_err(mpc)?, tug(t2).map_err(mpc)?],
+                    t.admm,
+                )
+                .map_err(|e| mpc(e.into()))?,
             )
-            .map_err(|e| ConfigError::new("distributed MPC", format!("{e:?}")))?,
-        ),
+        }
         Architecture::Centralized => Box::new(
-            Centralized::from_scenario(
-                &config.scenario,
-                config.hull,
-                config.prediction,
+            Centralized::new(
+                ship,
+                tugs,
+                formation,
                 ship_params,
                 tug_params,
-                config.centralized,
+                t.centralized,
             )
-            .map_err(|e| ConfigError::new("centralized MPC", format!("{e:?}")))?,
+            .map_err(mpc)?,
         ),
+    })
+}
+
+/// The prediction models of the scenario's vessels: the configured user hulls,
+/// or the built-in hull ([`ControllerConfig::hull`]); and the formation map.
+fn prediction_models(
+    config: &ControllerConfig,
+) -> Result<(ShipModel, [TugModel; 2], FormationMap), AdmmBuildError> {
+    let s = &config.scenario;
+    let p = config.tuning.prediction;
+    let formation = FormationMap::from_scenario(s)?;
+    Ok(match &config.hulls {
+        None => {
+            let hull = config.hull();
+            (
+                ShipModel::from_scenario(s, hull, p)?,
+                [
+                    TugModel::from_scenario(s, 0, hull, p)?,
+                    TugModel::from_scenario(s, 1, hull, p)?,
+                ],
+                formation,
+            )
+        }
+        Some(h) => {
+            let tug = |i: usize| {
+                TugModel::with_hull(
+                    i,
+                    PredictionHull::custom(h.tugs[i].clone_box()),
+                    &s.tug_data[i],
+                    p,
+                )
+            };
+            (
+                ShipModel::with_hull(PredictionHull::custom(h.ship.clone_box()), &s.ship_data, p)?,
+                [tug(0)?, tug(1)?],
+                formation,
+            )
+        }
     })
 }

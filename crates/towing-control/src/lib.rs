@@ -12,9 +12,13 @@
 //!
 //! let mut controller = Controller::new(ControllerConfig::new(Scenario::paper()?))?;
 //! let m = Measurement::default(); // from the plant's outputs
-//! let report = controller.sample(&m)?; // every T_s
-//! let between = controller.command_at(0.5, &m)?; // at every communication step
-//! # let _ = (report, between);
+//! // At every communication step: a control sample when one is due (every T_s),
+//! // then the command with the tugs' inner loop.
+//! let step = controller.step(0.0, &m)?;
+//! assert!(step.sample.is_some());
+//! let between = controller.step(0.1, &m)?;
+//! assert!(between.sample.is_none());
+//! # let _ = (step.command, between.command);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 #![forbid(unsafe_code)]
@@ -23,9 +27,15 @@
 pub mod config;
 pub mod controller;
 pub mod error;
+pub mod params;
 
 pub use config::{
-    Architecture, AvoidanceScheme, ControllerConfig, InnerLoopParams, TrackingParams,
+    Architecture, AvoidanceScheme, ControllerConfig, InnerLoopParams, PredictionHulls,
+    TrackingParams, Tuning, WaterwaySettings,
 };
-pub use controller::{Command, Controller, Fallback, Measurement, Prediction, SampleReport};
+pub use controller::{
+    Command, Controller, Fallback, Measurement, Prediction, SampleReport, Step, StepError,
+    SAMPLE_TOLERANCE,
+};
 pub use error::{ConfigError, MeasurementError};
+pub use params::{Parameter, Value, PARAMETERS};

@@ -3,8 +3,9 @@
 #![allow(clippy::unwrap_used)]
 
 use towing_control::{
-    AvoidanceScheme, Controller, ControllerConfig, Measurement, MeasurementError,
+    AvoidanceScheme, ConfigError, Controller, ControllerConfig, Measurement, MeasurementError,
 };
+use towing_guidance::{Role, Situation};
 use towing_model::{ObstacleKind, ObstacleSlot, Scenario, World};
 
 fn paper_measurement() -> (Scenario, Measurement) {
@@ -30,13 +31,13 @@ fn assert_within_bounds(c: &towing_control::Command, config: &ControllerConfig) 
     for f in c.tension {
         assert!(
             f.is_finite()
-                && f >= config.ship.min_tension - 1e-9
-                && f <= config.ship.max_tension + 1e-9,
+                && f >= config.tuning.ship.min_tension - 1e-9
+                && f <= config.tuning.ship.max_tension + 1e-9,
             "tension {f}"
         );
     }
     for tau in c.tug_thrust {
-        for (v, l) in tau.iter().zip(config.tug.thrust_limit) {
+        for (v, l) in tau.iter().zip(config.tuning.tug.thrust_limit) {
             assert!(v.is_finite() && v.abs() <= l + 1e-9, "thrust {v} over {l}");
         }
     }
@@ -74,6 +75,7 @@ fn a_non_finite_input_is_refused_by_name_and_changes_nothing() {
     assert!(err.to_string().contains("obstacle[3]"), "{err}");
     // Nothing was applied: the first real sample starts from rest.
     let f0 = ControllerConfig::new(Scenario::paper().unwrap())
+        .tuning
         .ship
         .min_tension;
     assert_eq!(c.applied().ship, [f0, f0, 0.0, 0.0]);
@@ -120,7 +122,7 @@ fn rate_bounds_hold_from_sample_to_sample() {
     let config = ControllerConfig::new(scenario);
     let mut c = Controller::new(config.clone()).unwrap();
     // From the pretension the controller starts with.
-    let f0 = config.ship.min_tension;
+    let f0 = config.tuning.ship.min_tension;
     assert_eq!(c.applied().ship, [f0, f0, 0.0, 0.0]);
     let mut prev = [f0, f0, 0.0, 0.0];
     for _ in 0..4 {
@@ -133,10 +135,10 @@ fn rate_bounds_hold_from_sample_to_sample() {
         ];
         for k in 0..2 {
             assert!(
-                (now[k] - prev[k]).abs() <= config.ship.tension_rate + 1e-6,
+                (now[k] - prev[k]).abs() <= config.tuning.ship.tension_rate + 1e-6,
                 "{now:?} {prev:?}"
             );
-            assert!((now[2 + k] - prev[2 + k]).abs() <= config.ship.angle_rate + 1e-6);
+            assert!((now[2 + k] - prev[2 + k]).abs() <= config.tuning.ship.angle_rate + 1e-6);
         }
         prev = now;
     }
@@ -159,9 +161,9 @@ fn scheme_three_tracks_the_unaltered_route_and_scheme_two_drops_the_distance_cos
     };
     let run = |scheme| {
         let mut config = ControllerConfig::new(scenario.clone());
-        config.scheme = scheme;
-        config.tracking.lookahead = 0.0;
-        config.tracking.los_distance = 0.0;
+        config.tuning.scheme = scheme;
+        config.tuning.tracking.lookahead = 0.0;
+        config.tuning.tracking.los_distance = 0.0;
         let mut c = Controller::new(config).unwrap();
         c.sample(&m).unwrap()
     };
@@ -171,8 +173,8 @@ fn scheme_three_tracks_the_unaltered_route_and_scheme_two_drops_the_distance_cos
     assert_eq!(one.reference, one.guidance.eta_sd.eta());
     assert_eq!(three.reference, three.guidance.route_waypoint.eta());
     assert_ne!(one.reference, three.reference);
-    assert_eq!(one.situation[3], 1, "head-on");
-    assert_eq!(one.role[3], 1, "give-way");
+    assert_eq!(one.situation[3], Some(Situation::HeadOn));
+    assert_eq!(one.role[3], Some(Role::GiveWay));
 }
 
 #[test]
@@ -182,7 +184,10 @@ fn the_lookahead_point_lies_ahead_on_the_leg_and_the_heading_looks_at_it() {
     let r = c.sample(&m).unwrap();
     // At the origin, on the route: `lookahead` along the first leg (course 101.3 deg).
     let course = (14.0f64 - 7.0).atan2(-6.3 + 4.9);
-    let ahead = ControllerConfig::new(scenario.clone()).tracking.lookahead;
+    let ahead = ControllerConfig::new(scenario.clone())
+        .tuning
+        .tracking
+        .lookahead;
     let expect = [-4.9 + ahead * course.cos(), 7.0 + ahead * course.sin()];
     assert!(
         (r.reference[0] - expect[0]).abs() < 1e-9 && (r.reference[1] - expect[1]).abs() < 1e-9,
@@ -196,24 +201,28 @@ fn the_lookahead_point_lies_ahead_on_the_leg_and_the_heading_looks_at_it() {
 fn bad_configuration_values_are_named() {
     let (scenario, _) = paper_measurement();
     let mut config = ControllerConfig::new(scenario);
-    config.tracking.lookahead = -1.0;
+    config.tuning.tracking.lookahead = -1.0;
+    let name = |e: ConfigError| match e {
+        ConfigError::Parameter { name, .. } => name,
+        other => panic!("{other}"),
+    };
     let err = Controller::new(config.clone()).unwrap_err();
-    assert_eq!(err.name, "lookahead");
-    config.tracking.lookahead = 3.0;
-    config.admm.max_iterations = 0;
+    assert_eq!(name(err), "tracking.lookahead");
+    config.tuning.tracking.lookahead = 3.0;
+    config.tuning.admm.max_iterations = 0;
     let err = Controller::new(config.clone()).unwrap_err();
-    assert_eq!(err.name, "max_iterations");
-    config.admm.max_iterations = 30;
-    config.inner.gain[1] = f64::NAN;
+    assert_eq!(name(err), "admm.max_iterations");
+    config.tuning.admm.max_iterations = 30;
+    config.tuning.inner.gain[1] = f64::NAN;
     let err = Controller::new(config).unwrap_err();
-    assert_eq!(err.name, "inner_loop_gain_sway");
+    assert_eq!(name(err), "inner_loop.bandwidth_sway");
 }
 
 #[test]
 fn a_failed_solve_applies_the_shifted_plan_within_bounds_then_comes_to_rest() {
     let (scenario, m) = paper_measurement();
     let config = ControllerConfig::new(scenario);
-    let p = config.ship;
+    let p = config.tuning.ship;
     let mut c = Controller::new(config.clone()).unwrap();
     for _ in 0..4 {
         let r = c.sample(&m).unwrap();
@@ -285,16 +294,17 @@ fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
     };
     m.obstacles[3] = target;
     let margin = ControllerConfig::new(scenario.clone())
+        .tuning
         .tracking
         .port_turn_margin;
     let controller = |scheme| {
         let mut config = ControllerConfig::new(scenario.clone());
-        config.scheme = scheme;
+        config.tuning.scheme = scheme;
         Controller::new(config).unwrap()
     };
     let mut c = controller(AvoidanceScheme::AlterAndCost);
     let r = c.sample(&m).unwrap();
-    assert_eq!(r.role[3], 1, "give-way");
+    assert_eq!(r.role[3], Some(Role::GiveWay));
     let floor = r.heading_floor.expect("a floor while giving way");
     assert!((floor - (psi - margin)).abs() < 1e-12, "{floor} vs {psi}");
 
@@ -316,4 +326,32 @@ fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
     // Scheme III: no COLREGS logic, no floor.
     let mut three = controller(AvoidanceScheme::CostOnly);
     assert_eq!(three.sample(&m).unwrap().heading_floor, None);
+}
+
+/// The controller's own clock: a sample at the first step and every T_s after
+/// (a communication point within 1 us of an instant samples; one that falls
+/// between instants does not), the command between samples from the inner loop.
+#[test]
+fn step_samples_on_its_own_clock() {
+    let (scenario, m) = paper_measurement();
+    let mut c = Controller::new(ControllerConfig::new(scenario)).unwrap();
+    c.set_start_time(10.0);
+    let mut sampled = Vec::new();
+    // 0.1 s steps summed the way masters do (t += h), with their rounding.
+    let mut t = 10.0;
+    for _ in 0..35 {
+        if c.step(t, &m).unwrap().sample.is_some() {
+            sampled.push(t);
+        }
+        t += 0.1;
+    }
+    assert_eq!(c.samples(), 4, "{sampled:?}");
+    for (k, s) in sampled.iter().enumerate() {
+        assert!((s - (10.0 + k as f64)).abs() < 1e-6, "{sampled:?}");
+    }
+    // A non-finite velocity is refused by name, and the step says where.
+    let mut bad = m;
+    bad.tugs[1][4] = f64::NAN;
+    let e = c.step(t, &bad).unwrap_err();
+    assert!(e.to_string().contains("tug2.v"), "{e}");
 }

@@ -86,14 +86,16 @@ pub fn contract_names() -> Vec<String> {
 
 /// The body of an FMU's model description binary: prints `description` as
 /// `modelDescription.xml` (argument `xml` or none), as the Markdown variable table of
-/// docs/interface.md (`markdown`) or as HTML documentation (`html`); used by
+/// docs/interface.md (`markdown`), the Markdown parameter tables of its registry
+/// (`parameters`, given) or as HTML documentation (`html`); used by
 /// `cargo xtask model-description` and `cargo xtask fmu`. Exit code 2 for an unknown
 /// argument, 1 when stdout cannot be written.
 #[must_use]
-pub fn model_description_main(description: &ModelDescription) -> ExitCode {
+pub fn model_description_main(description: &ModelDescription, parameters: &str) -> ExitCode {
     let text = match std::env::args().nth(1).as_deref() {
         Some("xml") | None => description.to_xml(),
         Some("markdown") => fmi2_slave::doc::variables_markdown(description),
+        Some("parameters") => parameters.to_owned(),
         Some("html") => fmi2_slave::doc::documentation_html(description),
         Some(other) => {
             let _ = writeln!(

@@ -58,6 +58,7 @@
 pub mod angle;
 pub mod config;
 pub mod kinetics;
+pub mod registry;
 pub mod scenario;
 pub mod state;
 pub mod towline;

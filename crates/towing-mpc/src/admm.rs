@@ -156,7 +156,14 @@ impl fmt::Display for AdmmBuildError {
     }
 }
 
-impl std::error::Error for AdmmBuildError {}
+impl std::error::Error for AdmmBuildError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            AdmmBuildError::Param(e) => Some(e),
+            AdmmBuildError::Qp(e) => Some(e),
+        }
+    }
+}
 
 impl From<ParamError> for AdmmBuildError {
     fn from(e: ParamError) -> Self {

@@ -86,11 +86,11 @@ pub fn assert_commands_within_bounds(fmu: &Fmu) {
         fmu.get_real(var.value_reference)
     };
     let limits = [
-        param("max_thrust_surge"),
-        param("max_thrust_sway"),
-        param("max_yaw_moment"),
+        param("mpc.tug.max_force_surge"),
+        param("mpc.tug.max_force_sway"),
+        param("mpc.tug.max_moment_yaw"),
     ];
-    let max_tension = param("max_tension");
+    let max_tension = param("mpc.ship.max_tension");
     for (i, x) in v.iter().enumerate() {
         assert!(x.is_finite(), "command {} is not finite: {x}", COMMANDS[i]);
     }

@@ -2,5 +2,8 @@
 //! (`markdown`) or its HTML documentation (`html`); used by `cargo xtask model-description`
 //! and `cargo xtask fmu`.
 fn main() -> std::process::ExitCode {
-    towing_interface::model_description_main(&towing_plant::variables::DESCRIPTION)
+    towing_interface::model_description_main(
+        &towing_plant::variables::DESCRIPTION,
+        &towing_model::registry::markdown(towing_plant::params::PARAMETERS),
+    )
 }

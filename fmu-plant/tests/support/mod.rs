@@ -41,7 +41,12 @@ impl Bench {
             fmu.set_string(vars::SCENARIO, scenario.to_str().unwrap()),
             Fmi2Status::Ok
         );
-        assert_eq!(fmu.set_integer(vars::HULL_MODEL, 2), Fmi2Status::Ok);
+        let vr = |name| vars::parameter_vr_of(name).unwrap();
+        assert_eq!(
+            fmu.set_boolean(vr("model.hull_from_scenario"), false),
+            Fmi2Status::Ok
+        );
+        assert_eq!(fmu.set_integer(vr("model.hull"), 2), Fmi2Status::Ok);
         if let Some(log) = log {
             assert_eq!(
                 fmu.set_string(vars::LOG_FILE, log.to_str().unwrap()),
