@@ -34,6 +34,7 @@ pub mod geometry;
 pub mod metric;
 pub mod metrics;
 pub mod paper;
+pub mod plot_clip;
 pub mod plot_sink;
 pub mod plots;
 pub mod progress;

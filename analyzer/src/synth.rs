@@ -65,6 +65,8 @@ pub struct SynthRun {
     pub obstacles: Vec<SynthObstacle>,
     /// Relative elongation amplitude of towline 1 and 2 (a sine of period 100 s).
     pub elongation: [f64; 2],
+    /// Desired length of towline 1 and 2 (the scenario's `desired_length`), m.
+    pub towline_length: [f64; 2],
     /// Write the scene, `/tf` and prediction topics too (realistic file sizes).
     pub scene: bool,
     /// Architecture and scheme codes of the solver topic.
@@ -120,6 +122,7 @@ impl SynthRun {
                 ship("C", -38.0, 40.5, 590.0),
             ],
             elongation: [0.03, 0.05],
+            towline_length: [1.0, 1.0],
             scene: true,
             architecture: 1,
             scheme: 1,
@@ -163,7 +166,11 @@ impl SynthRun {
         );
         s.push_str("[tug1]\nformation = { towing_angle_deg = 0.0 }\n\n");
         s.push_str("[tug2]\nformation = { towing_angle_deg = 0.0 }\n\n");
-        s.push_str("[towline1]\ndesired_length = 1.0\n\n[towline2]\ndesired_length = 1.0\n\n");
+        let _ = writeln!(
+            s,
+            "[towline1]\ndesired_length = {:?}\n\n[towline2]\ndesired_length = {:?}\n",
+            self.towline_length[0], self.towline_length[1]
+        );
         let pose =
             |p: [f64; 3]| format!("{{ x = {:?}, y = {:?}, psi_deg = {:?} }}", p[0], p[1], p[2]);
         let n = self.route.len();
