@@ -356,7 +356,7 @@ impl SolverCols {
         self.compute_time_ms.push(m.compute_time_ms);
         self.samples.push(m.samples);
         self.fallbacks.push(m.fallbacks);
-        let idx = m.fallback.map(|r| intern(&mut self.reasons, r));
+        let idx = (!m.fallback.is_empty()).then(|| intern(&mut self.reasons, m.fallback));
         self.fallback_idx.push(idx);
     }
 }

@@ -15,8 +15,8 @@ use std::path::Path;
 
 use towing_log::scene::{self, colors};
 use towing_log::topics::{
-    names, Colregs, Command, Encounter, FrameTransforms, ObstacleState, Obstacles, PlantInputs,
-    Prediction, Reference, SceneEntity, SceneUpdate, Solver, TowlineState, VesselState,
+    names, Colregs, Command, Encounter, FrameTransforms, NedPose, ObstacleState, Obstacles,
+    PlantInputs, Prediction, Reference, SceneEntity, SceneUpdate, Solver, TowlineState, VesselState,
 };
 use towing_log::{LogError, LogOptions, LogWriter, RunInfo};
 use towing_model::Scenario;
@@ -497,7 +497,11 @@ impl SynthRun {
             },
         )?;
         let iterations = 10 + u32::try_from(s * 5 % 21).unwrap_or(0);
-        let fallback = (s > 0 && s.is_multiple_of(500)).then(|| "synthetic fallback".to_owned());
+        let fallback = if s > 0 && s.is_multiple_of(500) {
+            "synthetic fallback".to_owned()
+        } else {
+            String::new()
+        };
         ctrl.write(
             names::CONTROLLER_SOLVER,
             t,
@@ -516,7 +520,7 @@ impl SynthRun {
             },
         )?;
         if self.scene {
-            let pose = |x: f64, y: f64| vec![[x, y, sp]; 3];
+            let pose = |x: f64, y: f64| vec![NedPose::new([x, y, sp]); 3];
             ctrl.write(
                 names::CONTROLLER_PREDICTION,
                 t,
