@@ -42,6 +42,7 @@ pub mod read;
 pub mod report;
 pub mod rows;
 pub mod run;
+pub mod same_run;
 pub mod step;
 pub mod stream;
 pub mod synth;

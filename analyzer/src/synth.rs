@@ -16,7 +16,8 @@ use std::path::Path;
 use towing_log::scene::{self, colors};
 use towing_log::topics::{
     names, Colregs, Command, Encounter, FrameTransforms, NedPose, ObstacleState, Obstacles,
-    PlantInputs, Prediction, Reference, SceneEntity, SceneUpdate, Solver, TowlineState, VesselState,
+    PlantInputs, Prediction, Reference, SceneEntity, SceneUpdate, Solver, TowlineState,
+    VesselState,
 };
 use towing_log::{LogError, LogOptions, LogWriter, RunInfo};
 use towing_model::Scenario;
@@ -75,6 +76,8 @@ pub struct SynthRun {
     pub scheme: i32,
     /// Command a tension of 3.5 N at this control sample (a bound violation).
     pub tension_spike_at_sample: Option<usize>,
+    /// The `run_id` of both logs' `run` metadata (empty: none).
+    pub run_id: String,
 }
 
 impl SynthRun {
@@ -127,6 +130,7 @@ impl SynthRun {
             architecture: 1,
             scheme: 1,
             tension_spike_at_sample: None,
+            run_id: String::new(),
         }
     }
 
@@ -327,6 +331,7 @@ impl SynthRun {
                 start_time: 0.0,
                 parameters: params.clone(),
                 scenario_text: text,
+                run_id: &self.run_id,
             })?;
         }
         Ok(())
@@ -369,6 +374,7 @@ impl SynthRun {
             stern,
             lengths,
             sample: k / self.steps_per_sample,
+            applied: k.checked_sub(1).map(|j| j / self.steps_per_sample),
         }
     }
 
@@ -435,14 +441,20 @@ impl SynthRun {
                 obstacles: obstacles.to_vec(),
             },
         )?;
+        // The command of the last sample before the step, as the controller logged it
+        // (zero before the first); so the logs pass the analyzer's same-run check.
+        let (thrust_in, tension_in) = tow.applied.map_or(([0.0; 3], [0.0; 2]), |s| {
+            let t_sample = (s * self.steps_per_sample) as f64 * self.dt;
+            (thrust(t_sample), [self.tension(s, 0), self.tension(s, 1)])
+        });
         plant.write(
             names::PLANT_INPUTS,
             t,
             &PlantInputs {
                 t,
-                tug1: thrust(t),
-                tug2: thrust(t),
-                tension_cmd: [self.tension(tow.sample, 0), self.tension(tow.sample, 1)],
+                tug1: thrust_in,
+                tug2: thrust_in,
+                tension_cmd: tension_in,
             },
         )?;
         Ok(())
@@ -554,6 +566,9 @@ struct TowAt {
     lengths: [f64; 2],
     /// Control sample the step belongs to.
     sample: usize,
+    /// The control sample whose command the plant applied over the step that ends here
+    /// (the last one before it, as under a Gauss-Seidel master); `None` at the first.
+    applied: Option<usize>,
 }
 
 /// Thrust of each tug (X N, Y N, N N m) at time `t`, s: commanded and applied alike.

@@ -387,6 +387,7 @@ impl ControllerFmu {
             start_time: self.clock.start_time,
             parameters: serde_json::Value::Object(parameters),
             scenario_text: &self.scenario_text,
+            ..RunInfo::default()
         };
         self.log = SharedLog::open(
             &p.log_file,

@@ -202,6 +202,7 @@ impl Plant {
             start_time: t,
             parameters,
             scenario_text: &loaded.text,
+            ..RunInfo::default()
         };
         // Written before the log's own thread takes over.
         self.log = SharedLog::open(&p.log_file, LogOptions::default(), &info, |writer| {

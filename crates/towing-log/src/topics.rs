@@ -151,6 +151,9 @@ pub mod metadata_keys {
     pub const START_TIME: &str = "start_time";
     /// JSON object of every parameter's value.
     pub const PARAMETERS: &str = "parameters";
+    /// Identifier of the run, the same in every unit's log; absent when the run has none
+    /// ([`crate::RunInfo::run_id`] empty).
+    pub const RUN_ID: &str = "run_id";
 }
 /// Value of the `epoch` metadata key.
 pub const EPOCH: &str = "simulation time 0 s";

@@ -492,12 +492,14 @@ fn run_metadata_and_the_scenario_attachment() {
         start_time: 0.0,
         parameters: serde_json::json!({"hull_model": 0, "scenario": ""}),
         scenario_text: "name = \"paper\"\n",
+        run_id: "",
     })
     .unwrap();
     w.finish().unwrap();
     let bytes = std::fs::read(&path).unwrap();
     let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
     let run = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).unwrap();
+    assert!(!run.metadata.contains_key("run_id"), "no run_id when empty");
     assert_eq!(run.name, "run");
     let m = &run.metadata;
     assert_eq!(m["unit"], "TowingPlant");
@@ -573,6 +575,27 @@ fn topic_tables_match_the_contract() {
         ));
     assert_eq!(topics::situation_name(2), "crossing give-way");
     assert_eq!(topics::role_name(2), "stand-on");
+}
+
+#[test]
+fn a_run_id_is_written_in_the_run_metadata() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("run.mcap");
+    let mut w = LogWriter::create(&path, LogOptions::default()).unwrap();
+    w.write_run(&towing_log::RunInfo {
+        unit: "TowingController",
+        run_id: "campaign-7/run-0042",
+        ..towing_log::RunInfo::default()
+    })
+    .unwrap();
+    w.finish().unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let run = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).unwrap();
+    assert_eq!(
+        run.metadata[topics::metadata_keys::RUN_ID],
+        "campaign-7/run-0042"
+    );
 }
 
 #[test]
