@@ -39,6 +39,7 @@ pub mod plot_sink;
 pub mod plots;
 pub mod progress;
 pub mod read;
+pub mod record_lengths;
 pub mod report;
 pub mod rows;
 pub mod run;

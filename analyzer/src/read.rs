@@ -20,7 +20,10 @@
 //! has left (a record length corrupted into the exabytes reads to the end of the file and
 //! stops there as a truncation), and a record longer than [`MAX_RECORD_BYTES`] (in the
 //! file or inside a decompressed chunk) stops it the same way, before any buffer is sized
-//! by it. The same reading works on bytes in memory ([`read_log_bytes`],
+//! by it. The length fields inside the records the analyzer parses (schemas, channels,
+//! messages, metadata, attachments) are checked against the record before the mcap crate
+//! parses it ([`crate::record_lengths`]); the other records are not parsed. The same
+//! reading works on bytes in memory ([`read_log_bytes`],
 //! [`peek_log_bytes`]: tests and the fuzzers).
 
 use std::collections::BTreeMap;
@@ -38,6 +41,7 @@ use towing_log::topics::{
 };
 
 use crate::error::{AnalyzerError, Result};
+use crate::record_lengths;
 
 /// The longest record the reader accepts, bytes (the MCAP reader's `record_length_limit`):
 /// 64 MiB. `towing_log` writes chunks of at most 1 MiB uncompressed, messages of a few kB
@@ -815,9 +819,14 @@ fn scan_source(
                     past_data_end = true;
                     continue;
                 }
-                if past_data_end {
-                    // The summary repeats schemas and channels; nothing new there.
+                if past_data_end || !record_lengths::parsed(opcode) {
+                    // The summary repeats schemas and channels; nothing new there. Nor in
+                    // the header, the message indexes or records unknown to us.
                     continue;
+                }
+                if let Err(reason) = record_lengths::check(opcode, data) {
+                    broken_record(&mut log, opcode, &reason, records - 1)?;
+                    break;
                 }
                 let record = match mcap::parse_record(opcode, data) {
                     Ok(record) => record,
@@ -1022,6 +1031,20 @@ fn stop_at_error(log: &mut LogFile, err: McapError, records: u64, bytes: u64) ->
             Ok(())
         }
     }
+}
+
+/// A record whose length fields do not fit in it ([`record_lengths::check`]): the log is
+/// unreadable when no record came before it (`read` of them did), else truncated there.
+fn broken_record(log: &mut LogFile, opcode: u8, reason: &str, read: u64) -> Result<()> {
+    let reason = format!("a record (opcode 0x{opcode:02x}) is corrupt: {reason}");
+    if read == 0 {
+        return Err(AnalyzerError::Unreadable {
+            path: log.path.clone(),
+            reason,
+        });
+    }
+    log.truncated = Some(format!("the log is broken after {read} records: {reason}"));
+    Ok(())
 }
 
 /// The MCAP reader's error in words; a length beyond [`MAX_RECORD_BYTES`] is called what

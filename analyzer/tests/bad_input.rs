@@ -154,6 +154,34 @@ fn a_flipped_bit_in_the_controller_log_gives_a_report_or_a_clean_error() {
 }
 
 #[test]
+fn a_string_length_of_2e9_in_the_run_metadata_is_a_clean_error() {
+    // Found by fuzz-mcap: mcap's record parser sized a buffer by a string's length prefix
+    // (4 GB here), an abort under a memory limit.
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/real-3s");
+    let mut bytes = std::fs::read(data.join("plant.mcap")).expect("fixture");
+    let metadata = record_length_fields(&bytes)
+        .into_iter()
+        .find(|&field| bytes[field - 1] == 0x0c)
+        .expect("a top-level Metadata record");
+    // The name's length: 3 (`run`) with its top bit set.
+    let name_len = metadata + 8;
+    assert_eq!(bytes[name_len..name_len + 4], [3, 0, 0, 0]);
+    bytes[name_len + 3] ^= 0x80;
+    let name = Path::new("metadata.mcap");
+    let e = within("a corrupt metadata string", move || {
+        read_log_bytes(name, &bytes)
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    })
+    .expect_err("no message before it");
+    assert_clean("corrupt metadata", &e, "metadata.mcap");
+    assert!(
+        e.contains("a record (opcode 0x0c) is corrupt: its name claims 2147483651 bytes"),
+        "{e}"
+    );
+}
+
+#[test]
 fn the_mcap_magic_followed_by_random_bytes_is_a_clean_error() {
     const MAGIC: &[u8] = b"\x89MCAP0\r\n";
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
