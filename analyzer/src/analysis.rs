@@ -16,6 +16,7 @@ use crate::metric::FinishContext;
 pub use crate::metric::Metrics;
 pub use crate::plot_sink::PlotData;
 use crate::run::Run;
+use crate::same_run::{Checked, CommandCheck};
 use crate::stream::{PlantStream, StreamOptions};
 use crate::thresholds::Thresholds;
 
@@ -50,14 +51,30 @@ pub fn analyze_run(
 ) -> Result<Analysis> {
     let mut run = run;
     loop {
+        let mut check = run
+            .controller_log()
+            .map(|c| CommandCheck::new(&run.controller.command, &run.plant_path, c));
         let ctrl = crate::frames::build_controller(
             std::mem::take(&mut run.controller),
             &run.config.route,
         )?;
         let mut stream = PlantStream::new(&run.config, &ctrl, tables, opts, thresholds)?;
         let bar = progress.add(crate::progress::bytes_bar(&run.plant_path));
-        let read = crate::read::read_into(&run.plant_path, &bar, &mut stream);
+        let read = match &mut check {
+            Some(check) => {
+                let mut checked = Checked {
+                    inner: &mut stream,
+                    check,
+                };
+                crate::read::read_into(&run.plant_path, &bar, &mut checked)
+            }
+            None => crate::read::read_into(&run.plant_path, &bar, &mut stream),
+        };
         bar.finish_and_clear();
+        let read = read.and_then(|log| {
+            check.as_ref().map_or(Ok(()), CommandCheck::finish)?;
+            Ok(log)
+        });
         let log = match read {
             Ok(log) => log,
             Err(e) => {

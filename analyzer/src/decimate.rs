@@ -223,8 +223,11 @@ pub struct PathDecimator {
     last: Option<(f64, f64)>,
 }
 
+/// Distance between two positions, at most `f64::MAX`: an infinite gap (two positions
+/// near `f64::MAX` of opposite signs) would pass every tolerance and keep
+/// [`PathDecimator::thin`] doubling it for ever.
 fn gap(p: (f64, f64), q: (f64, f64)) -> f64 {
-    (p.0 - q.0).hypot(p.1 - q.1)
+    (p.0 - q.0).hypot(p.1 - q.1).min(f64::MAX)
 }
 
 impl PathDecimator {
@@ -499,5 +502,21 @@ pub(crate) mod tests {
         }
         assert_eq!(e.points().len(), cap);
         assert_eq!(e.tolerance(), 0.0);
+    }
+
+    #[test]
+    fn a_path_of_positions_near_f64_max_thins_in_bounded_time() {
+        // Positions of opposite signs near f64::MAX are an infinite distance apart; the
+        // thinning used to double its tolerance for ever (a hang of the analyzer on a log
+        // with absurd coordinates).
+        let cap = 8;
+        let mut d = PathDecimator::new(cap);
+        for i in 0..1000 {
+            let s = if i % 2 == 0 { 1.0 } else { -1.0 };
+            d.push(s * f64::MAX, -s * 1.7e308);
+            assert!(d.points().len() <= cap + 1, "{} points", d.points().len());
+        }
+        assert_eq!(d.points().first(), Some(&(f64::MAX, -1.7e308)));
+        assert_eq!(d.points().last(), Some(&(-f64::MAX, 1.7e308)));
     }
 }

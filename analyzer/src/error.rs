@@ -73,6 +73,16 @@ pub enum AnalyzerError {
         /// The second file.
         second: PathBuf,
     },
+    /// The logs given for one run are of different runs (`crate::same_run`).
+    #[error("{first} and {second} are logs of different runs: {reason}")]
+    DifferentRuns {
+        /// One log.
+        first: PathBuf,
+        /// The other.
+        second: PathBuf,
+        /// What differs, and where.
+        reason: String,
+    },
     /// No log with the plant's vessel states among the inputs.
     #[error("no plant log among {files}: the report needs /plant/ship, /plant/tug1, /plant/tug2")]
     NoPlantLog {

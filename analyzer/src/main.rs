@@ -46,7 +46,15 @@ enum Command {
     },
 }
 
-#[allow(clippy::print_stdout)]
+/// `println!` that does not panic when stdout is closed (`analyzer report ... | head -1`):
+/// the report is written either way, and nobody reads the lines.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+    }};
+}
+
 fn main() -> ExitCode {
     // Library code returns errors; should anything still panic, say so in one line.
     std::panic::set_hook(Box::new(|info| {
@@ -68,7 +76,7 @@ fn main() -> ExitCode {
                         t.file, t.reason
                     );
                 }
-                println!(
+                say!(
                     "report written to {} ({} files){}",
                     out.display(),
                     outcome.written.len(),
@@ -78,7 +86,7 @@ fn main() -> ExitCode {
                         ""
                     }
                 );
-                println!(
+                say!(
                     "settling time: {}; max elongation error: {} / {}; ship travel {:.2} m; collisions {}; bound violations {}; fallbacks {}",
                     m.settling
                         .settling_time_s
@@ -91,11 +99,11 @@ fn main() -> ExitCode {
                     m.solver.fallbacks
                 );
                 if m.verdict.passed {
-                    println!("verdict: passed");
+                    say!("verdict: passed");
                 } else {
-                    println!("verdict: FAILED ({} reasons)", m.verdict.reasons.len());
+                    say!("verdict: FAILED ({} reasons)", m.verdict.reasons.len());
                     for r in &m.verdict.reasons {
-                        println!("  {}", r.line());
+                        say!("  {}", r.line());
                     }
                 }
                 ExitCode::SUCCESS
@@ -111,7 +119,7 @@ fn main() -> ExitCode {
             runs,
         } => match analyzer::compare(&out, &runs) {
             Ok(outcome) => {
-                println!(
+                say!(
                     "comparison of {} runs written to {}",
                     outcome.runs.len(),
                     out.display()

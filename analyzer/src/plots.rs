@@ -10,10 +10,12 @@ use std::sync::OnceLock;
 
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
+use plotters::element::{Drawable, PointCollection};
 use plotters::prelude::*;
 
 use crate::error::{AnalyzerError, Result};
 use crate::geometry::{body_to_ned, circle, ellipse, hull_outline};
+use crate::plot_clip::{axis, range_of, Window};
 use crate::plot_sink::{ObstacleTrack, PlotData};
 
 /// DejaVu Sans (Bitstream Vera license, `assets/DejaVuSans-LICENSE.txt`).
@@ -141,25 +143,70 @@ fn decimate_points(pts: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
     out
 }
 
-fn range_of<'a>(values: impl Iterator<Item = &'a f64>) -> Option<Range<f64>> {
-    let (lo, hi) = values
-        .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(v), hi.max(v))
-        });
-    if lo > hi {
-        return None;
+/// Dash and gap lengths, px, of a dashed line (`None`: solid).
+type Dashes = Option<(i32, i32)>;
+
+impl Dash {
+    fn dashes(self) -> Dashes {
+        match self {
+            Dash::Solid => None,
+            Dash::Dashed => Some((10, 5)),
+            Dash::Dotted => Some((3, 4)),
+        }
     }
-    if (hi - lo) < 1e-12 {
-        let pad = if lo.abs() > 1e-12 {
-            lo.abs() * 0.1
-        } else {
-            1.0
+}
+
+/// Draws the polyline `pts`, clipped to `window` (the chart's, [`Window::around`]), solid
+/// or with `dashes`, in `style`. With `legend` (label, style of its short line) the first
+/// piece is labelled; when nothing of the line is in the window, an empty series carries
+/// the label.
+fn draw_clipped<DB: DrawingBackend>(
+    chart: &mut MapChart<'_, DB>,
+    window: &Window,
+    pts: &[(f64, f64)],
+    dashes: Dashes,
+    style: ShapeStyle,
+    legend: Option<(&str, ShapeStyle)>,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    let mut pieces = window.polyline(pts);
+    if pieces.is_empty() && legend.is_some() {
+        pieces.push(Vec::new());
+    }
+    for (k, piece) in pieces.into_iter().enumerate() {
+        let anno = match dashes {
+            None => chart.draw_series(LineSeries::new(piece, style))?,
+            Some((size, gap)) => {
+                chart.draw_series(DashedLineSeries::new(piece, size, gap, style))?
+            }
         };
-        return Some(lo - pad..hi + pad);
+        if let (0, Some((label, legend_style))) = (k, legend) {
+            anno.label(label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], legend_style));
+        }
     }
-    let pad = 0.05 * (hi - lo);
-    Some(lo - pad..hi + pad)
+    Ok(())
+}
+
+/// Draws the polygon `pts` clipped to `window`, filled with `fill` (nothing when none of it
+/// is in the window).
+fn fill_clipped<DB: DrawingBackend>(
+    chart: &mut MapChart<'_, DB>,
+    window: &Window,
+    pts: &[(f64, f64)],
+    fill: ShapeStyle,
+) -> std::result::Result<bool, Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let poly = window.polygon(pts);
+    if poly.is_empty() {
+        return Ok(false);
+    }
+    chart.draw_series(std::iter::once(Polygon::new(poly, fill)))?;
+    Ok(true)
 }
 
 fn draw_panel<DB: DrawingBackend>(
@@ -178,6 +225,8 @@ where
             .chain(panel.bounds.iter().map(|b| &b.0)),
     )
     .unwrap_or(-1.0..1.0);
+    let x_range = axis(x_range.start, x_range.end);
+    let window = Window::around(&x_range, &y_range);
     let mut chart = ChartBuilder::on(area)
         .caption(&panel.title, (FAMILY, 18))
         .margin(8)
@@ -194,15 +243,9 @@ where
         .draw()?;
     for (value, label) in &panel.bounds {
         let style = BOUND.stroke_width(1);
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(x_range.start, *value), (x_range.end, *value)],
-                8,
-                5,
-                style,
-            ))?
-            .label(label.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        let bound = [(x_range.start, *value), (x_range.end, *value)];
+        let legend = Some((label.as_str(), style));
+        draw_clipped(&mut chart, &window, &bound, Some((8, 5)), style, legend)?;
     }
     let mut labelled = false;
     for line in &panel.lines {
@@ -210,23 +253,16 @@ where
             continue;
         }
         let style = line.color.stroke_width(line.width);
-        let anno = match line.dash {
-            Dash::Solid => chart.draw_series(LineSeries::new(line.pts.iter().copied(), style))?,
-            Dash::Dashed => chart.draw_series(DashedLineSeries::new(
-                line.pts.iter().copied(),
-                10,
-                5,
-                style,
-            ))?,
-            Dash::Dotted => {
-                chart.draw_series(DashedLineSeries::new(line.pts.iter().copied(), 3, 4, style))?
-            }
-        };
-        if !line.label.is_empty() {
-            labelled = true;
-            anno.label(line.label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
-        }
+        let legend = (!line.label.is_empty()).then_some((line.label.as_str(), style));
+        labelled |= legend.is_some();
+        draw_clipped(
+            &mut chart,
+            &window,
+            &line.pts,
+            line.dash.dashes(),
+            style,
+            legend,
+        )?;
     }
     if labelled || !panel.bounds.is_empty() {
         chart
@@ -263,9 +299,9 @@ where
 fn x_range(span: Option<(f64, f64)>) -> Range<f64> {
     let (lo, hi) = span.unwrap_or((0.0, 1.0));
     if hi > lo {
-        lo..hi
+        axis(lo, hi)
     } else {
-        lo..lo + 1.0
+        axis(lo, lo + 1.0)
     }
 }
 
@@ -579,7 +615,7 @@ pub fn map_layout(d: &PlotData) -> ((u32, u32), Range<f64>, Range<f64>) {
         plot_h = min_h;
     }
     let h = (plot_h + extra_h).round() as u32;
-    ((MAP_WIDTH, h), e0..e1, n0..n1)
+    ((MAP_WIDTH, h), axis(e0, e1), axis(n0, n1))
 }
 
 /// Indices of `n` evenly spaced sample times (the paper's Fig. 8 shows ten states).
@@ -601,6 +637,7 @@ fn en(p: [f64; 2]) -> (f64, f64) {
 }
 
 /// Draws the map (the paper's Fig. 8 style) on `root`: East range `er`, North range `nr`, m.
+/// Everything is clipped to the window around the chart ([`Window`]).
 fn draw_map<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     d: &PlotData,
@@ -611,6 +648,7 @@ where
     DB::ErrorType: 'static,
 {
     root.fill(&WHITE)?;
+    let window = Window::around(&er, &nr);
     let mut chart = ChartBuilder::on(root)
         .caption(format!("map: {}", d.title), (FAMILY, 22))
         .margin(20)
@@ -625,15 +663,19 @@ where
         .axis_desc_style((FAMILY, 16))
         .light_line_style(RGBColor(238, 238, 238))
         .draw()?;
-    draw_route(&mut chart, d)?;
-    draw_hazards(&mut chart, d)?;
+    let mut map = Map {
+        chart: &mut chart,
+        window,
+    };
+    draw_route(&mut map, d)?;
+    draw_hazards(&mut map, d)?;
     let samples = sample_indices(&d.poses.t, 10);
     let sample_times: Vec<f64> = samples.iter().map(|&i| d.poses.t[i]).collect();
-    draw_targets(&mut chart, d, &sample_times)?;
+    draw_targets(&mut map, d, &sample_times)?;
     // The tow: tracks, then hull outlines and towlines at the sampled times.
-    draw_tow_tracks(&mut chart, d)?;
+    draw_tow_tracks(&mut map, d)?;
     for &i in &samples {
-        draw_tow_at(&mut chart, d, i)?;
+        draw_tow_at(&mut map, d, i)?;
     }
     chart
         .configure_series_labels()
@@ -645,31 +687,76 @@ where
     Ok(())
 }
 
+/// The map's chart and the window its geometry is clipped to.
+struct Map<'c, 'a, DB: DrawingBackend> {
+    chart: &'c mut MapChart<'a, DB>,
+    window: Window,
+}
+
+impl<DB: DrawingBackend> Map<'_, '_, DB>
+where
+    DB::ErrorType: 'static,
+{
+    /// A polyline ([`draw_clipped`]).
+    fn line(
+        &mut self,
+        pts: &[(f64, f64)],
+        dashes: Dashes,
+        style: ShapeStyle,
+        legend: Option<(&str, ShapeStyle)>,
+    ) -> DrawResult {
+        draw_clipped(self.chart, &self.window, pts, dashes, style, legend)
+    }
+
+    /// A closed outline: the polygon filled with `fill`, its edge drawn in `edge`.
+    fn outline(&mut self, pts: &[(f64, f64)], fill: ShapeStyle, edge: ShapeStyle) -> DrawResult {
+        fill_clipped(self.chart, &self.window, pts, fill)?;
+        let mut closed = pts.to_vec();
+        if let Some(&first) = pts.first() {
+            closed.push(first);
+        }
+        self.line(&closed, None, edge, None)
+    }
+
+    /// `element`, placed at `at`, when `at` is in the window.
+    fn at<E>(&mut self, at: (f64, f64), element: E) -> DrawResult
+    where
+        for<'b> &'b E: PointCollection<'b, (f64, f64)>,
+        E: Drawable<DB>,
+    {
+        if self.window.contains(at) {
+            self.chart.draw_series(std::iter::once(element))?;
+        }
+        Ok(())
+    }
+}
+
 /// Route and waypoints, the destination, the altered waypoints.
-fn draw_route<DB: DrawingBackend>(chart: &mut MapChart<'_, DB>, d: &PlotData) -> DrawResult
+fn draw_route<DB: DrawingBackend>(map: &mut Map<'_, '_, DB>, d: &PlotData) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
     let route: Vec<(f64, f64)> = d.route.iter().map(|p| (p[1], p[0])).collect();
-    chart
-        .draw_series(DashedLineSeries::new(
-            route.iter().copied(),
-            10,
-            6,
-            ROUTE.stroke_width(2),
-        ))?
-        .label("route")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], ROUTE.stroke_width(2)));
-    chart.draw_series(route.iter().map(|&p| Circle::new(p, 4, ROUTE.filled())))?;
-    if let Some(&dest) = route.last() {
-        chart.draw_series(std::iter::once(Cross::new(dest, 9, BLACK.stroke_width(3))))?;
+    let style = ROUTE.stroke_width(2);
+    map.line(&route, Some((10, 6)), style, Some(("route", style)))?;
+    for &p in &route {
+        map.at(p, Circle::new(p, 4, ROUTE.filled()))?;
     }
+    if let Some(&dest) = route.last() {
+        map.at(dest, Cross::new(dest, 9, BLACK.stroke_width(3)))?;
+    }
+    let altered: Vec<(f64, f64)> = d
+        .altered_waypoints
+        .iter()
+        .map(|w| (w[1], w[0]))
+        .filter(|&p| map.window.contains(p))
+        .collect();
     if !d.altered_waypoints.is_empty() {
-        chart
+        map.chart
             .draw_series(
-                d.altered_waypoints
-                    .iter()
-                    .map(|w| TriangleMarker::new((w[1], w[0]), 8, ALTERED.filled())),
+                altered
+                    .into_iter()
+                    .map(|p| TriangleMarker::new(p, 8, ALTERED.filled())),
             )?
             .label("altered waypoints")
             .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, ALTERED.filled()));
@@ -678,7 +765,7 @@ where
 }
 
 /// Static hazards with their safe circles (ship's safe distance, eq. (14)).
-fn draw_hazards<DB: DrawingBackend>(chart: &mut MapChart<'_, DB>, d: &PlotData) -> DrawResult
+fn draw_hazards<DB: DrawingBackend>(map: &mut Map<'_, '_, DB>, d: &PlotData) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
@@ -689,10 +776,10 @@ where
         };
         let r = o.length.max(o.width) / 2.0;
         let body: Vec<(f64, f64)> = circle(x, y, r, 48).into_iter().map(en).collect();
-        let a = chart.draw_series(std::iter::once(Polygon::new(
-            body,
-            HAZARD.mix(0.6).filled(),
-        )))?;
+        let body = map.window.polygon(&body);
+        let a = map.chart.draw_series(
+            (!body.is_empty()).then(|| Polygon::new(body, HAZARD.mix(0.6).filled())),
+        )?;
         if !hazard_legend {
             a.label("static hazard")
                 .legend(|(x, y)| Circle::new((x + 10, y), 5, HAZARD.filled()));
@@ -701,17 +788,12 @@ where
         if let Some(&first) = safe.first() {
             safe.push(first);
         }
-        let a = chart.draw_series(DashedLineSeries::new(safe, 6, 5, BOUND.stroke_width(1)))?;
-        if !hazard_legend {
-            a.label("safe distance (ship)")
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BOUND));
-            hazard_legend = true;
-        }
-        chart.draw_series(std::iter::once(Text::new(
-            o.name.clone(),
-            (y + r * 0.9, x + r * 0.9),
-            (FAMILY, 18).into_font().color(&BLACK),
-        )))?;
+        let legend = (!hazard_legend).then_some(("safe distance (ship)", BOUND.into()));
+        map.line(&safe, Some((6, 5)), BOUND.stroke_width(1), legend)?;
+        hazard_legend = true;
+        let label_at = (y + r * 0.9, x + r * 0.9);
+        let font = (FAMILY, 18).into_font().color(&BLACK);
+        map.at(label_at, Text::new(o.name.clone(), label_at, font))?;
     }
     Ok(())
 }
@@ -719,7 +801,7 @@ where
 /// Target ships: tracks, and outlines at the sampled times (`sample_times`, s) when
 /// active.
 fn draw_targets<DB: DrawingBackend>(
-    chart: &mut MapChart<'_, DB>,
+    map: &mut Map<'_, '_, DB>,
     d: &PlotData,
     sample_times: &[f64],
 ) -> DrawResult
@@ -738,12 +820,10 @@ where
         } else {
             track
         };
-        let a = chart.draw_series(LineSeries::new(track, TARGET.stroke_width(1)))?;
-        if !target_legend {
-            a.label("target ships")
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], TARGET));
-            target_legend = true;
-        }
+        let style = TARGET.stroke_width(1);
+        let legend = (!target_legend).then_some(("target ships", TARGET.into()));
+        map.line(&track, None, style, legend)?;
+        target_legend = true;
         // The track may be thinned (StreamOptions::track_rows): accept the nearest kept
         // row.
         let spacing = match (o.t.first(), o.t.last()) {
@@ -756,14 +836,12 @@ where
             if k >= o.t.len() || (o.t[k] - ts).abs() > tolerance {
                 continue;
             }
-            draw_target_outline(chart, o, k)?;
+            draw_target_outline(map, o, k)?;
         }
         if let (Some(&x), Some(&y)) = (o.x.first(), o.y.first()) {
-            chart.draw_series(std::iter::once(Text::new(
-                o.name.clone(),
-                (y + 0.5, x),
-                (FAMILY, 18).into_font().color(&TARGET),
-            )))?;
+            let label_at = (y + 0.5, x);
+            let font = (FAMILY, 18).into_font().color(&TARGET);
+            map.at(label_at, Text::new(o.name.clone(), label_at, font))?;
         }
     }
     Ok(())
@@ -771,33 +849,25 @@ where
 
 /// The outline of target ship `o` at its row `k`, with a dot at the bow.
 fn draw_target_outline<DB: DrawingBackend>(
-    chart: &mut MapChart<'_, DB>,
+    map: &mut Map<'_, '_, DB>,
     o: &ObstacleTrack,
     k: usize,
 ) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
-    let mut outline: Vec<(f64, f64)> =
+    let outline: Vec<(f64, f64)> =
         ellipse(o.x[k], o.y[k], o.psi[k], o.length / 2.0, o.width / 2.0, 40)
             .into_iter()
             .map(en)
             .collect();
-    chart.draw_series(std::iter::once(Polygon::new(
-        outline.clone(),
-        TARGET.mix(0.25).filled(),
-    )))?;
-    if let Some(&f) = outline.first() {
-        outline.push(f);
-    }
-    chart.draw_series(std::iter::once(PathElement::new(outline, TARGET)))?;
-    let bow = body_to_ned(o.x[k], o.y[k], o.psi[k], o.length / 2.0, 0.0);
-    chart.draw_series(std::iter::once(Circle::new(en(bow), 2, TARGET.filled())))?;
-    Ok(())
+    map.outline(&outline, TARGET.mix(0.25).filled(), TARGET.into())?;
+    let bow = en(body_to_ned(o.x[k], o.y[k], o.psi[k], o.length / 2.0, 0.0));
+    map.at(bow, Circle::new(bow, 2, TARGET.filled()))
 }
 
 /// The tracks of ship, tug 1 and tug 2, with their legend entries.
-fn draw_tow_tracks<DB: DrawingBackend>(chart: &mut MapChart<'_, DB>, d: &PlotData) -> DrawResult
+fn draw_tow_tracks<DB: DrawingBackend>(map: &mut Map<'_, '_, DB>, d: &PlotData) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
@@ -806,26 +876,15 @@ where
         // decimate_points() keeps the samples' order, so the track stays a path.
         let pts = decimate_points(d.tracks[k].clone());
         let color = TOW_COLORS[k];
-        chart
-            .draw_series(LineSeries::new(
-                pts,
-                color.stroke_width(if k == 0 { 2 } else { 1 }),
-            ))?
-            .label(labels[k])
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-            });
+        let style = color.stroke_width(if k == 0 { 2 } else { 1 });
+        map.line(&pts, None, style, Some((labels[k], color.stroke_width(2))))?;
     }
     Ok(())
 }
 
 /// The towlines and hull outlines of the tow at pose sample `i`, labelled with its time
 /// (nothing when the ship's pose is not finite).
-fn draw_tow_at<DB: DrawingBackend>(
-    chart: &mut MapChart<'_, DB>,
-    d: &PlotData,
-    i: usize,
-) -> DrawResult
+fn draw_tow_at<DB: DrawingBackend>(map: &mut Map<'_, '_, DB>, d: &PlotData, i: usize) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
@@ -850,38 +909,25 @@ where
         }
         let a = body_to_ned(sx, sy, sp, ship_end, 0.0);
         let b = body_to_ned(tx, ty, tp, tug_end, 0.0);
-        chart.draw_series(std::iter::once(PathElement::new(
-            vec![en(a), en(b)],
-            BLACK.stroke_width(1),
-        )))?;
+        map.line(&[en(a), en(b)], None, BLACK.stroke_width(1), None)?;
     }
     for (k, color) in TOW_COLORS.iter().enumerate() {
         let (x, y, p) = pose(k);
         if !(x.is_finite() && y.is_finite() && p.is_finite()) {
             continue;
         }
-        let mut hull: Vec<(f64, f64)> = hull_outline(x, y, p, d.sizes[k][0], d.sizes[k][1])
+        let hull: Vec<(f64, f64)> = hull_outline(x, y, p, d.sizes[k][0], d.sizes[k][1])
             .into_iter()
             .map(en)
             .collect();
-        chart.draw_series(std::iter::once(Polygon::new(
-            hull.clone(),
-            color.mix(0.35).filled(),
-        )))?;
-        if let Some(&f) = hull.first() {
-            hull.push(f);
-        }
-        chart.draw_series(std::iter::once(PathElement::new(
-            hull,
-            color.stroke_width(1),
-        )))?;
+        map.outline(&hull, color.mix(0.35).filled(), color.stroke_width(1))?;
     }
-    chart.draw_series(std::iter::once(Text::new(
-        format!("{:.0} s", d.poses.t[i]),
-        (sy + 0.9, sx + 0.4),
-        (FAMILY, 13).into_font().color(&BLACK),
-    )))?;
-    Ok(())
+    let label_at = (sy + 0.9, sx + 0.4);
+    let font = (FAMILY, 13).into_font().color(&BLACK);
+    map.at(
+        label_at,
+        Text::new(format!("{:.0} s", d.poses.t[i]), label_at, font),
+    )
 }
 
 fn plot_error(path: &Path, e: impl std::fmt::Display) -> AnalyzerError {

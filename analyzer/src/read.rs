@@ -15,6 +15,16 @@
 //! A log that ends early (a crashed run, a file being written, a partial copy) stops the
 //! MCAP reader with an error at the first broken record; everything before it is kept and
 //! the file is marked [`LogFile::truncated`].
+//!
+//! Lengths in a file are not trusted: the reader never asks for more bytes than the file
+//! has left (a record length corrupted into the exabytes reads to the end of the file and
+//! stops there as a truncation), and a record longer than [`MAX_RECORD_BYTES`] (in the
+//! file or inside a decompressed chunk) stops it the same way, before any buffer is sized
+//! by it. The length fields inside the records the analyzer parses (schemas, channels,
+//! messages, metadata, attachments) are checked against the record before the mcap crate
+//! parses it ([`crate::record_lengths`]); the other records are not parsed. The same
+//! reading works on bytes in memory ([`read_log_bytes`],
+//! [`peek_log_bytes`]: tests and the fuzzers).
 
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -22,7 +32,7 @@ use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
 use mcap::records::Record;
-use mcap::sans_io::{LinearReadEvent, LinearReader};
+use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mcap::McapError;
 use serde::de::DeserializeOwned;
 use towing_log::topics::{
@@ -31,6 +41,13 @@ use towing_log::topics::{
 };
 
 use crate::error::{AnalyzerError, Result};
+use crate::record_lengths;
+
+/// The longest record the reader accepts, bytes (the MCAP reader's `record_length_limit`):
+/// 64 MiB. `towing_log` writes chunks of at most 1 MiB uncompressed, messages of a few kB
+/// and the scenario text as the only attachment; a longer record is a corrupted length,
+/// and the log is read as truncated before it.
+pub const MAX_RECORD_BYTES: usize = 64 << 20;
 
 /// Which FMU wrote a log.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -343,7 +360,7 @@ impl SolverCols {
         self.compute_time_ms.push(m.compute_time_ms);
         self.samples.push(m.samples);
         self.fallbacks.push(m.fallbacks);
-        let idx = m.fallback.map(|r| intern(&mut self.reasons, r));
+        let idx = (!m.fallback.is_empty()).then(|| intern(&mut self.reasons, m.fallback));
         self.fallback_idx.push(idx);
     }
 }
@@ -690,31 +707,91 @@ pub fn read_into(
 /// give first).
 pub fn peek_log(path: &Path) -> Result<Peek> {
     let (log, channels) = scan(path, &indicatif::ProgressBar::hidden(), None)?;
-    let (plant, controller) = unit_topics(&channels);
-    Ok(Peek {
+    Ok(peek_of(log, &channels))
+}
+
+/// What [`peek_log`] says of the records read.
+fn peek_of(log: LogFile, channels: &BTreeMap<u16, ChannelInfo>) -> Peek {
+    let (plant, controller) = unit_topics(channels);
+    Peek {
         path: log.path,
         bytes: log.bytes,
         unit: decide_unit(&log.metadata, plant, controller),
         metadata: log.metadata,
         scenario_text: log.scenario_text,
-    })
+    }
 }
 
-/// The reading loop: every record with `sink`, or (`None`) up to the first message.
+/// [`read_log`] of a log held in memory, `data`; `name` stands for the file in messages.
+///
+/// # Errors
+/// As [`read_log`] (an empty `data` is [`AnalyzerError::Empty`]).
+pub fn read_log_bytes(name: &Path, data: &[u8]) -> Result<LogFile> {
+    let mut plant = PlantData::default();
+    let mut controller = ControllerData::default();
+    let mut sink = Everything {
+        plant: &mut plant,
+        controller: &mut controller,
+    };
+    let (log, channels) = scan_bytes(name, data, Some(&mut sink))?;
+    let mut log = finish(log, &channels)?;
+    log.plant = plant;
+    log.controller = controller;
+    Ok(log)
+}
+
+/// [`peek_log`] of a log held in memory, `data`; `name` stands for the file in messages.
+///
+/// # Errors
+/// As [`peek_log`].
+pub fn peek_log_bytes(name: &Path, data: &[u8]) -> Result<Peek> {
+    let (log, channels) = scan_bytes(name, data, None)?;
+    Ok(peek_of(log, &channels))
+}
+
+/// The reading loop over `data`, the bytes of the log `name`.
+fn scan_bytes(
+    name: &Path,
+    data: &[u8],
+    sink: Option<&mut dyn Sink>,
+) -> Result<(LogFile, BTreeMap<u16, ChannelInfo>)> {
+    if data.is_empty() {
+        return Err(AnalyzerError::Empty {
+            path: name.to_owned(),
+        });
+    }
+    let mut source = data;
+    scan_source(name, &mut source, data.len() as u64, sink)
+}
+
+/// The reading loop over the file `path`: every record with `sink`, or (`None`) up to the
+/// first message.
 fn scan(
     path: &Path,
     progress: &indicatif::ProgressBar,
+    sink: Option<&mut dyn Sink>,
+) -> Result<(LogFile, BTreeMap<u16, ChannelInfo>)> {
+    let (mut source, bytes) = open_counted(path, progress)?;
+    let scanned = scan_source(path, &mut source, bytes, sink);
+    progress.set_position(bytes);
+    scanned
+}
+
+/// The reading loop over `source`, the `bytes` bytes of the log `path` (named in messages):
+/// every record with `sink`, or (`None`) up to the first message.
+fn scan_source(
+    path: &Path,
+    source: &mut dyn Read,
+    bytes: u64,
     mut sink: Option<&mut dyn Sink>,
 ) -> Result<(LogFile, BTreeMap<u16, ChannelInfo>)> {
-    let io_err = |source| AnalyzerError::Io {
-        path: path.to_owned(),
-        source,
-    };
-    let (mut source, bytes) = open_counted(path, progress)?;
     let mut log = nothing_read(path, bytes);
     let mut channels: BTreeMap<u16, ChannelInfo> = BTreeMap::new();
     let mut schema_names: BTreeMap<u16, String> = BTreeMap::new();
-    let mut reader = LinearReader::new();
+    let mut reader = LinearReader::new_with_options(
+        LinearReaderOptions::default().with_record_length_limit(MAX_RECORD_BYTES),
+    );
+    let mut unread = bytes;
     let mut past_data_end = false;
     let mut records = 0u64;
     let mut last_t_ns = i64::MIN;
@@ -729,14 +806,12 @@ fn scan(
         };
         match event {
             LinearReadEvent::ReadRequest(need) => {
-                let read = loop {
-                    match source.read(reader.insert(need)) {
-                        Ok(n) => break n,
-                        Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-                        Err(e) => return Err(io_err(e)),
+                feed(&mut reader, source, need, &mut unread).map_err(|source| {
+                    AnalyzerError::Io {
+                        path: path.to_owned(),
+                        source,
                     }
-                };
-                reader.notify_read(read);
+                })?;
             }
             LinearReadEvent::Record { opcode, data } => {
                 records += 1;
@@ -744,9 +819,14 @@ fn scan(
                     past_data_end = true;
                     continue;
                 }
-                if past_data_end {
-                    // The summary repeats schemas and channels; nothing new there.
+                if past_data_end || !record_lengths::parsed(opcode) {
+                    // The summary repeats schemas and channels; nothing new there. Nor in
+                    // the header, the message indexes or records unknown to us.
                     continue;
+                }
+                if let Err(reason) = record_lengths::check(opcode, data) {
+                    broken_record(&mut log, opcode, &reason, records - 1)?;
+                    break;
                 }
                 let record = match mcap::parse_record(opcode, data) {
                     Ok(record) => record,
@@ -783,8 +863,30 @@ fn scan(
             }
         }
     }
-    progress.set_position(bytes);
     Ok((log, channels))
+}
+
+/// Answers the reader's request for `need` more bytes from `source`, which has `unread`
+/// bytes left: never more than that, so a corrupted length sizes no buffer beyond the
+/// file (the reader then meets the end of the file and stops as truncated).
+fn feed(
+    reader: &mut LinearReader,
+    source: &mut dyn Read,
+    need: usize,
+    unread: &mut u64,
+) -> std::io::Result<()> {
+    let want = need.min(usize::try_from(*unread).unwrap_or(usize::MAX));
+    let buf = reader.insert(want);
+    let read = loop {
+        match source.read(buf) {
+            Ok(n) => break n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    };
+    *unread = unread.saturating_sub(read as u64);
+    reader.notify_read(read);
+    Ok(())
 }
 
 /// Opens `path` for reading through a 1 MiB buffer that advances `progress` (its length
@@ -914,17 +1016,52 @@ fn stop_at_error(log: &mut LogFile, err: McapError, records: u64, bytes: u64) ->
         }),
         err if records == 0 => Err(AnalyzerError::Unreadable {
             path: log.path.clone(),
-            reason: err.to_string(),
+            reason: reader_reason(&err),
         }),
         err => {
             log.truncated = Some(match err {
                 McapError::UnexpectedEof => {
                     "the log ends in the middle of a record (truncated)".to_owned()
                 }
-                other => format!("the log is broken after {records} records: {other}"),
+                other => format!(
+                    "the log is broken after {records} records: {}",
+                    reader_reason(&other)
+                ),
             });
             Ok(())
         }
+    }
+}
+
+/// A record whose length fields do not fit in it ([`record_lengths::check`]): the log is
+/// unreadable when no record came before it (`read` of them did), else truncated there.
+fn broken_record(log: &mut LogFile, opcode: u8, reason: &str, read: u64) -> Result<()> {
+    let reason = format!("a record (opcode 0x{opcode:02x}) is corrupt: {reason}");
+    if read == 0 {
+        return Err(AnalyzerError::Unreadable {
+            path: log.path.clone(),
+            reason,
+        });
+    }
+    log.truncated = Some(format!("the log is broken after {read} records: {reason}"));
+    Ok(())
+}
+
+/// The MCAP reader's error in words; a length beyond [`MAX_RECORD_BYTES`] is called what
+/// it is.
+fn reader_reason(err: &McapError) -> String {
+    match err {
+        McapError::RecordTooLarge { opcode, len } => format!(
+            "a record (opcode 0x{opcode:02x}) claims {len} bytes, more than the {} MiB a \
+             record may have (a corrupted length)",
+            MAX_RECORD_BYTES >> 20
+        ),
+        McapError::ChunkTooLarge(len) => format!(
+            "a chunk claims {len} bytes, more than the {} MiB a record may have (a \
+             corrupted length)",
+            MAX_RECORD_BYTES >> 20
+        ),
+        other => other.to_string(),
     }
 }
 

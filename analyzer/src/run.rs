@@ -157,6 +157,14 @@ impl Run {
         self.files.iter().any(|f| f.truncated.is_some())
     }
 
+    /// The controller log, when it is not the plant log itself (a merged log).
+    #[must_use]
+    pub fn controller_log(&self) -> Option<&Path> {
+        self.controller_path
+            .map(|k| self.paths[k].as_path())
+            .filter(|p| *p != self.plant_path)
+    }
+
     /// The files, comma separated (for messages).
     #[must_use]
     pub fn file_list(&self) -> String {
@@ -246,6 +254,7 @@ fn load(
         .iter()
         .map(|p| peek_log(p))
         .collect::<Result<Vec<Peek>>>()?;
+    crate::same_run::check_run_ids(&peeks)?;
     // The plant log: peeked as one (or as both units).
     let peeked_plant = peeks.iter().enumerate().filter_map(|(k, peek)| {
         let is_plant = matches!(peek.unit, Some(Unit::Plant | Unit::Both))

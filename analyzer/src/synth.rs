@@ -15,8 +15,9 @@ use std::path::Path;
 
 use towing_log::scene::{self, colors};
 use towing_log::topics::{
-    names, Colregs, Command, Encounter, FrameTransforms, ObstacleState, Obstacles, PlantInputs,
-    Prediction, Reference, SceneEntity, SceneUpdate, Solver, TowlineState, VesselState,
+    names, Colregs, Command, Encounter, FrameTransforms, NedPose, ObstacleState, Obstacles,
+    PlantInputs, Prediction, Reference, SceneEntity, SceneUpdate, Solver, TowlineState,
+    VesselState,
 };
 use towing_log::{LogError, LogOptions, LogWriter, RunInfo};
 use towing_model::Scenario;
@@ -65,6 +66,8 @@ pub struct SynthRun {
     pub obstacles: Vec<SynthObstacle>,
     /// Relative elongation amplitude of towline 1 and 2 (a sine of period 100 s).
     pub elongation: [f64; 2],
+    /// Desired length of towline 1 and 2 (the scenario's `desired_length`), m.
+    pub towline_length: [f64; 2],
     /// Write the scene, `/tf` and prediction topics too (realistic file sizes).
     pub scene: bool,
     /// Architecture and scheme codes of the solver topic.
@@ -73,6 +76,8 @@ pub struct SynthRun {
     pub scheme: i32,
     /// Command a tension of 3.5 N at this control sample (a bound violation).
     pub tension_spike_at_sample: Option<usize>,
+    /// The `run_id` of both logs' `run` metadata (empty: none).
+    pub run_id: String,
 }
 
 impl SynthRun {
@@ -120,10 +125,12 @@ impl SynthRun {
                 ship("C", -38.0, 40.5, 590.0),
             ],
             elongation: [0.03, 0.05],
+            towline_length: [1.0, 1.0],
             scene: true,
             architecture: 1,
             scheme: 1,
             tension_spike_at_sample: None,
+            run_id: String::new(),
         }
     }
 
@@ -163,7 +170,11 @@ impl SynthRun {
         );
         s.push_str("[tug1]\nformation = { towing_angle_deg = 0.0 }\n\n");
         s.push_str("[tug2]\nformation = { towing_angle_deg = 0.0 }\n\n");
-        s.push_str("[towline1]\ndesired_length = 1.0\n\n[towline2]\ndesired_length = 1.0\n\n");
+        let _ = writeln!(
+            s,
+            "[towline1]\ndesired_length = {:?}\n\n[towline2]\ndesired_length = {:?}\n",
+            self.towline_length[0], self.towline_length[1]
+        );
         let pose =
             |p: [f64; 3]| format!("{{ x = {:?}, y = {:?}, psi_deg = {:?} }}", p[0], p[1], p[2]);
         let n = self.route.len();
@@ -320,6 +331,7 @@ impl SynthRun {
                 start_time: 0.0,
                 parameters: params.clone(),
                 scenario_text: text,
+                run_id: &self.run_id,
             })?;
         }
         Ok(())
@@ -362,6 +374,7 @@ impl SynthRun {
             stern,
             lengths,
             sample: k / self.steps_per_sample,
+            applied: k.checked_sub(1).map(|j| j / self.steps_per_sample),
         }
     }
 
@@ -428,14 +441,20 @@ impl SynthRun {
                 obstacles: obstacles.to_vec(),
             },
         )?;
+        // The command of the last sample before the step, as the controller logged it
+        // (zero before the first); so the logs pass the analyzer's same-run check.
+        let (thrust_in, tension_in) = tow.applied.map_or(([0.0; 3], [0.0; 2]), |s| {
+            let t_sample = (s * self.steps_per_sample) as f64 * self.dt;
+            (thrust(t_sample), [self.tension(s, 0), self.tension(s, 1)])
+        });
         plant.write(
             names::PLANT_INPUTS,
             t,
             &PlantInputs {
                 t,
-                tug1: thrust(t),
-                tug2: thrust(t),
-                tension_cmd: [self.tension(tow.sample, 0), self.tension(tow.sample, 1)],
+                tug1: thrust_in,
+                tug2: thrust_in,
+                tension_cmd: tension_in,
             },
         )?;
         Ok(())
@@ -490,7 +509,11 @@ impl SynthRun {
             },
         )?;
         let iterations = 10 + u32::try_from(s * 5 % 21).unwrap_or(0);
-        let fallback = (s > 0 && s.is_multiple_of(500)).then(|| "synthetic fallback".to_owned());
+        let fallback = if s > 0 && s.is_multiple_of(500) {
+            "synthetic fallback".to_owned()
+        } else {
+            String::new()
+        };
         ctrl.write(
             names::CONTROLLER_SOLVER,
             t,
@@ -509,7 +532,7 @@ impl SynthRun {
             },
         )?;
         if self.scene {
-            let pose = |x: f64, y: f64| vec![[x, y, sp]; 3];
+            let pose = |x: f64, y: f64| vec![NedPose::new([x, y, sp]); 3];
             ctrl.write(
                 names::CONTROLLER_PREDICTION,
                 t,
@@ -543,6 +566,9 @@ struct TowAt {
     lengths: [f64; 2],
     /// Control sample the step belongs to.
     sample: usize,
+    /// The control sample whose command the plant applied over the step that ends here
+    /// (the last one before it, as under a Gauss-Seidel master); `None` at the first.
+    applied: Option<usize>,
 }
 
 /// Thrust of each tug (X N, Y N, N N m) at time `t`, s: commanded and applied alike.

@@ -277,3 +277,30 @@ fn thresholds_file_is_recorded_and_a_bad_one_is_refused_by_name() {
     assert!(err.contains("t.toml") && err.contains("drift_max"), "{err}");
     assert!(err.starts_with("analyzer report: thresholds "), "{err}");
 }
+
+#[test]
+fn a_closed_stdout_is_not_a_panic() {
+    // `analyzer report ... | head -1` closed the pipe before the summary lines: they
+    // panicked ("failed printing to stdout: Broken pipe") after the report was written.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let run = common::straight(10.0, 0.1, 100);
+    let (plant, controller) = common::write_logs(&run, dir.path());
+    let (reader, writer) = std::io::pipe().expect("pipe");
+    drop(reader);
+    let out = dir.path().join("report");
+    let o = analyzer()
+        .args(["report", "--quiet", "--out"])
+        .arg(&out)
+        .arg(&plant)
+        .arg(&controller)
+        .stdout(writer)
+        .output()
+        .expect("run");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !err.contains("panicked") && !err.contains("internal error"),
+        "{err}"
+    );
+    assert!(o.status.success(), "{err}");
+    assert!(out.join("metrics.json").exists());
+}

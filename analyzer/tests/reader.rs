@@ -369,7 +369,7 @@ fn a_merged_log_with_late_controller_topics_and_scenario_is_read_whole() {
                 compute_time_ms: 4.0,
                 samples: u64::from(k / 10 + 1),
                 fallbacks: 0,
-                fallback: None,
+                fallback: String::new(),
             };
             w.write_to_known_channel(&header(id, k), &serde_json::to_vec(&m).expect("json"))
                 .expect("write");

@@ -7,8 +7,8 @@ use crate::diagnostics::{role_code, situation_code};
 use towing_control::{Measurement, SampleReport};
 use towing_log::scene::{self, colors};
 use towing_log::topics::{
-    names, role_name, situation_name, Colregs, Command, Encounter, Log, Prediction, Reference,
-    SceneEntity, SceneUpdate, Solver, CONTROLLER_TOPICS,
+    names, role_name, situation_name, Colregs, Command, Encounter, Log, NedPose, Prediction,
+    Reference, SceneEntity, SceneUpdate, Solver, CONTROLLER_TOPICS,
 };
 use towing_log::{LogError, LogWriter};
 use towing_model::{ObstacleKind, Pose, MAX_OBSTACLES};
@@ -124,11 +124,14 @@ pub fn write_sample(w: &mut LogWriter, s: &Sample) -> Result<(), LogError> {
             compute_time_ms: r.compute_time * 1e3,
             samples: s.samples,
             fallbacks: r.fallbacks,
-            fallback: r.fallback.map(|f| f.to_string()),
+            fallback: r.fallback.map(|f| f.to_string()).unwrap_or_default(),
         },
     )?;
-    let poses = |states: &[[f64; 6]]| -> Vec<[f64; 3]> {
-        states.iter().map(|x| [x[0], x[1], x[2]]).collect()
+    let poses = |states: &[[f64; 6]]| -> Vec<NedPose> {
+        states
+            .iter()
+            .map(|x| NedPose::new([x[0], x[1], x[2]]))
+            .collect()
     };
     let prediction = Prediction {
         t,
@@ -160,8 +163,7 @@ fn scene_update(s: &Sample, p: &Prediction, waypoint: [f64; 3]) -> SceneUpdate {
     let mut paths = SceneEntity::new("prediction", t);
     let starts = [&m.ship, &m.tugs[0], &m.tugs[1]];
     for (start, states) in starts.into_iter().zip([&p.ship, &p.tug1, &p.tug2]) {
-        let points =
-            std::iter::once([start[0], start[1]]).chain(states.iter().map(|x| [x[0], x[1]]));
+        let points = std::iter::once([start[0], start[1]]).chain(states.iter().map(|p| [p.x, p.y]));
         paths
             .lines
             .push(scene::line_strip(points, 0.05, 0.03, colors::PREDICTION));

@@ -140,6 +140,7 @@ impl RunSession {
             start_time: header.start_time,
             parameters: header.parameters,
             scenario_text: &loaded.text,
+            ..RunInfo::default()
         };
         self.log = SharedLog::open(&self.log_file, LogOptions::default(), &info, setup)
             .map_err(|e| format!("parameter `log_file`: {e}"))?;

@@ -34,6 +34,15 @@ macro_rules! schema_names {
         $(impl TopicMessage for $ty {
             const SCHEMA_NAME: &'static str = $name;
         })*
+
+        /// The schema name and JSON schema ([`crate::schema_json`]) of every message type
+        /// of the contract: every schema a channel of either unit can have.
+        ///
+        /// # Errors
+        /// serde_json's error (not expected for derived schemas).
+        pub fn contract_schemas() -> Result<Vec<(&'static str, Vec<u8>)>, serde_json::Error> {
+            Ok(vec![$(($name, crate::writer::schema_json::<$ty>()?)),*])
+        }
     };
 }
 
@@ -142,6 +151,9 @@ pub mod metadata_keys {
     pub const START_TIME: &str = "start_time";
     /// JSON object of every parameter's value.
     pub const PARAMETERS: &str = "parameters";
+    /// Identifier of the run, the same in every unit's log; absent when the run has none
+    /// ([`crate::RunInfo::run_id`] empty).
+    pub const RUN_ID: &str = "run_id";
 }
 /// Value of the `epoch` metadata key.
 pub const EPOCH: &str = "simulation time 0 s";
@@ -345,22 +357,50 @@ pub struct Solver {
     pub samples: u64,
     /// Samples since instantiation whose plan was replaced by the shifted previous plan, 1.
     pub fallbacks: u64,
-    /// The reason when this sample fell back, otherwise null.
-    pub fallback: Option<String>,
+    /// The reason when this sample fell back, otherwise empty. A string, never null:
+    /// Foxglove's JSON-schema parser refuses a union type (docs/logging.md); logs written
+    /// before this rule, with `null`, read as empty.
+    #[serde(deserialize_with = "null_as_empty")]
+    pub fallback: String,
 }
 
-/// Predicted poses over the horizon (`/controller/prediction`): each entry North m, East
-/// m, heading rad (NED), one per sample ahead (1..N).
+/// A string field that older logs wrote as `null` when empty.
+fn null_as_empty<'de, D: serde::Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+    Ok(Option::<String>::deserialize(d)?.unwrap_or_default())
+}
+
+/// A pose in the NED world frame.
+#[derive(Serialize, Deserialize, JsonSchema, Debug, Clone, Copy, PartialEq, Default)]
+pub struct NedPose {
+    /// North, m (NED).
+    pub x: f64,
+    /// East, m (NED).
+    pub y: f64,
+    /// Heading from North, clockwise, rad (NED).
+    pub psi: f64,
+}
+
+impl NedPose {
+    /// The pose `[x m, y m, psi rad]`.
+    #[must_use]
+    pub fn new([x, y, psi]: [f64; 3]) -> Self {
+        NedPose { x, y, psi }
+    }
+}
+
+/// Predicted poses over the horizon (`/controller/prediction`), one per sample ahead
+/// (1..N). Arrays of objects, not of `[x, y, psi]` arrays: Foxglove's JSON-schema parser
+/// refuses an array whose items are arrays (docs/logging.md).
 #[derive(Serialize, Deserialize, JsonSchema, Debug, Clone, PartialEq)]
 pub struct Prediction {
     /// Simulation time of the sample, s.
     pub t: f64,
-    /// Ship poses [x m, y m, psi rad] over the horizon (NED).
-    pub ship: Vec<[f64; 3]>,
-    /// Aft tug poses [x m, y m, psi rad] over the horizon (NED).
-    pub tug1: Vec<[f64; 3]>,
-    /// Forward tug poses [x m, y m, psi rad] over the horizon (NED).
-    pub tug2: Vec<[f64; 3]>,
+    /// Ship poses over the horizon (NED).
+    pub ship: Vec<NedPose>,
+    /// Aft tug poses over the horizon (NED).
+    pub tug1: Vec<NedPose>,
+    /// Forward tug poses over the horizon (NED).
+    pub tug2: Vec<NedPose>,
 }
 
 // ---------------------------------------------------------------------------------------

@@ -507,7 +507,7 @@ impl LogWriter {
 }
 
 /// What a run's `run` Metadata record and scenario attachment hold (docs/logging.md).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct RunInfo<'a> {
     /// `TowingPlant` or `TowingController`.
     pub unit: &'a str,
@@ -526,6 +526,10 @@ pub struct RunInfo<'a> {
     pub parameters: serde_json::Value,
     /// The scenario text used (attached as `scenario.toml`).
     pub scenario_text: &'a str,
+    /// An identifier of the run shared by every unit's log (empty by default: none). When
+    /// set, it is written as the metadata key `run_id`, and the analyzer refuses to put
+    /// together logs whose ids differ (docs/logging.md).
+    pub run_id: &'a str,
 }
 
 impl LogWriter {
@@ -549,8 +553,10 @@ impl LogWriter {
             (k::EPOCH, t::EPOCH.to_owned()),
             (k::START_TIME, format!("{}", info.start_time)),
             (k::PARAMETERS, info.parameters.to_string()),
+            (k::RUN_ID, info.run_id.to_owned()),
         ]
         .into_iter()
+        .filter(|(key, value)| *key != k::RUN_ID || !value.is_empty())
         .map(|(key, value)| (key.to_owned(), value))
         .collect();
         self.metadata(t::METADATA_RUN, entries)?;

@@ -115,7 +115,11 @@ fn write_run(path: &Path, steps: usize, options: LogOptions) -> LogWriter {
                 compute_time_ms: 12.5,
                 samples: k as u64 + 1,
                 fallbacks: 0,
-                fallback: (k == 3).then(|| "the ship QP gave no usable solution".to_owned()),
+                fallback: if k == 3 {
+                    "the ship QP gave no usable solution".to_owned()
+                } else {
+                    String::new()
+                },
             },
         )
         .unwrap();
@@ -488,12 +492,14 @@ fn run_metadata_and_the_scenario_attachment() {
         start_time: 0.0,
         parameters: serde_json::json!({"hull_model": 0, "scenario": ""}),
         scenario_text: "name = \"paper\"\n",
+        run_id: "",
     })
     .unwrap();
     w.finish().unwrap();
     let bytes = std::fs::read(&path).unwrap();
     let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
     let run = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).unwrap();
+    assert!(!run.metadata.contains_key("run_id"), "no run_id when empty");
     assert_eq!(run.name, "run");
     let m = &run.metadata;
     assert_eq!(m["unit"], "TowingPlant");
@@ -569,4 +575,44 @@ fn topic_tables_match_the_contract() {
         ));
     assert_eq!(topics::situation_name(2), "crossing give-way");
     assert_eq!(topics::role_name(2), "stand-on");
+}
+
+#[test]
+fn a_run_id_is_written_in_the_run_metadata() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("run.mcap");
+    let mut w = LogWriter::create(&path, LogOptions::default()).unwrap();
+    w.write_run(&towing_log::RunInfo {
+        unit: "TowingController",
+        run_id: "campaign-7/run-0042",
+        ..towing_log::RunInfo::default()
+    })
+    .unwrap();
+    w.finish().unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let run = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).unwrap();
+    assert_eq!(
+        run.metadata[topics::metadata_keys::RUN_ID],
+        "campaign-7/run-0042"
+    );
+}
+
+#[test]
+fn a_solver_message_of_an_older_log_with_a_null_fallback_reads_as_empty() {
+    let old = r#"{"t":1.0,"architecture":1,"scheme":1,"iterations":7,"converged":true,
+        "r_pri":[0.001,0.002],"r_dual":[0.0005,0.0001],"compute_time_ms":4.5,"samples":2,
+        "fallbacks":0,"fallback":null}"#;
+    let m: Solver = serde_json::from_str(old).unwrap();
+    assert_eq!(m.fallback, "");
+    let fell = old.replace("null", "\"the ship QP failed\"");
+    let m: Solver = serde_json::from_str(&fell).unwrap();
+    assert_eq!(m.fallback, "the ship QP failed");
+    // Written as a string, never null.
+    let back = serde_json::to_value(Solver {
+        fallback: String::new(),
+        ..m
+    })
+    .unwrap();
+    assert_eq!(back["fallback"], "");
 }

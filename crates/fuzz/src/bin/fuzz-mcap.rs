@@ -1,0 +1,6 @@
+//! `fuzz-mcap --iterations N --seed S --out DIR`: see `towing_fuzz::targets::McapReader` and
+//! docs/analyzer.md ("Fuzzing").
+
+fn main() -> std::process::ExitCode {
+    towing_fuzz::run_main(&towing_fuzz::targets::McapReader)
+}
