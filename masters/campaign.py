@@ -98,9 +98,23 @@ def load_campaign(path):
     return c
 
 
+def _flatten(table, prefix=""):
+    """A TOML table whose dotted keys (`admm.rho = [...]`, `plant.model.hull = [...]`) TOML
+    nests, as one level of dotted names: parameter names are grouped `group.name`."""
+    flat = {}
+    for key, value in table.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            flat.update(_flatten(value, f"{name}."))
+        else:
+            flat[name] = value
+    return flat
+
+
 def _parameters(table, path):
     if not isinstance(table, dict):
         raise CampaignError(f"{path}: [parameters] must be a table of NAME = [values], got {table!r}")
+    table = _flatten(table)
     for name, values in table.items():
         where = f"{path}: [parameters] {name}"
         if not isinstance(values, list) or not values:

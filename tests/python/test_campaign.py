@@ -241,10 +241,14 @@ def test_parameters_and_globs_are_checked_before_anything_runs(tmp_path, fmus):
     c = campaign.load_campaign(write(tmp_path, "[parameters]\narchitecture = [1, 3]\n"))
     with pytest.raises(campaign.CampaignError, match=r"controller parameter 'architecture' must be in \[1, 2\] .*, got 3"):
         campaign.check_parameters(c, fmus["TowingPlant"], fmus["TowingController"])
-    c = campaign.load_campaign(write(tmp_path, "[parameters]\n\"plant.hull_model\" = [1, 2]\narchitecture = [1, 2]\n"))
+    c = campaign.load_campaign(write(tmp_path, "[parameters]\n\"plant.model.hull\" = [1, 2]\narchitecture = [1, 2]\n"))
     campaign.check_parameters(c, fmus["TowingPlant"], fmus["TowingController"])
-    assert campaign.configurations(c) == [{"plant.hull_model": 1, "architecture": 1}, {"plant.hull_model": 1, "architecture": 2},
-                                          {"plant.hull_model": 2, "architecture": 1}, {"plant.hull_model": 2, "architecture": 2}]
+    assert campaign.configurations(c) == [{"plant.model.hull": 1, "architecture": 1}, {"plant.model.hull": 1, "architecture": 2},
+                                          {"plant.model.hull": 2, "architecture": 1}, {"plant.model.hull": 2, "architecture": 2}]
+    # dotted keys as TOML writes them (nested tables) are the same grouped names
+    c = campaign.load_campaign(write(tmp_path, "[parameters]\nplant.model.hull = [2]\nadmm.rho = [1.0, 2.0]\n"))
+    campaign.check_parameters(c, fmus["TowingPlant"], fmus["TowingController"])
+    assert campaign.configurations(c) == [{"plant.model.hull": 2, "admm.rho": 1.0}, {"plant.model.hull": 2, "admm.rho": 2.0}]
     c = campaign.load_campaign(write(tmp_path, ""))
     c["scenarios"] = ["suites/*.toml"]
     with pytest.raises(campaign.CampaignError, match="'scenarios' entry 'suites/\\*.toml' matches no file"):

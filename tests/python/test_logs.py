@@ -2,7 +2,7 @@
 (masters/closed_loop.py --log-dir) and read with the Python `mcap` package:
 
 - message counts per topic match the run (plant: one per step plus one at the start, the
-  Foxglove topics `/tf` and `/plant/scene` one per `log_scene_interval` = 0.5 s plus one at
+  Foxglove topics `/tf` and `/plant/scene` one per `log.scene_interval` = 0.5 s plus one at
   the start; controller: one per control sample);
 - every message validates against its channel's JSON schema (jsonschema);
 - log times never decrease within a file, and equal the `t` the messages carry;
@@ -34,7 +34,7 @@ PLANT_TOPICS = [
     "/plant/obstacles",
     "/plant/inputs",
 ]
-# Written at the start and then every `log_scene_interval` (0.5 s by default, 5 steps).
+# Written at the start and then every `log.scene_interval` (0.5 s by default, 5 steps).
 PLANT_SCENE_TOPICS = ["/tf", "/plant/scene"]
 CONTROLLER_TOPICS = [
     "/controller/reference",
