@@ -37,7 +37,7 @@ use towing_interface::codec::{
     obstacle_kind_code, obstacle_kind_from_code, ContractVariable, ObstacleField, TowlineField,
     Vessel,
 };
-use towing_interface::{LogHeader, RunSession};
+use towing_interface::{parameters, LogHeader, RunSession};
 
 const STATE_MAGIC: &[u8; 4] = b"TWCT";
 
@@ -164,23 +164,12 @@ impl ControllerFmu {
     /// Creates the log named by `log_file` (if any) and writes the run description.
     fn open_log(&mut self, log: &Logger) -> Result<(), String> {
         let guid = vars::DESCRIPTION.guid();
-        let mut parameters = serde_json::Map::new();
-        parameters.insert("scenario".into(), self.session.scenario_parameter().into());
-        parameters.insert("log_file".into(), self.session.log_file().into());
-        for p in PARAMETERS {
-            let value = match p.get(&self.params) {
-                Value::Real(v) => v.into(),
-                Value::Integer(v) => v.into(),
-                Value::Boolean(v) => v.into(),
-            };
-            parameters.insert(p.name.into(), value);
-        }
         let header = LogHeader {
             unit: vars::MODEL_IDENTIFIER,
             guid: &guid,
             version: env!("CARGO_PKG_VERSION"),
             start_time: self.start_time,
-            parameters: serde_json::Value::Object(parameters),
+            parameters: parameters::values_json(PARAMETERS, &self.params),
         };
         self.session.open_log(log, header, logging::register_topics)
     }

@@ -25,12 +25,12 @@ use crate::diagnostics::{self, DIAGNOSTICS};
 use fmi2_slave::description::{ModelDescription, VariableKind};
 use fmi2_slave::ValueType;
 use std::sync::LazyLock;
-use towing_control::params::{Kind, PARAMETERS};
-use towing_control::Tuning;
+use towing_control::params::PARAMETERS;
 use towing_interface::codec::{
     ContractVariable, ModelVariable, Towline, TowlineField, VariableTable,
 };
-use towing_interface::variables::{self as shared, calculated_output, parameter, Direction};
+use towing_interface::parameters;
+use towing_interface::variables::{self as shared, calculated_output, Direction};
 use towing_interface::{ModelInfo, RealType};
 
 /// The model identifier (binary name).
@@ -40,19 +40,12 @@ pub use towing_interface::vr::{
     obstacle, tension_cmd, towline, tug_force, vessel_state, LOG_FILE, OBSTACLE_KIND, SCENARIO,
 };
 
-/// Value reference of the registry's parameter `index`.
-#[must_use]
-pub const fn parameter_vr(index: usize) -> u32 {
-    10 + index as u32
-}
+pub use towing_interface::parameters::parameter_vr;
 
 /// Value reference of the parameter `name` of the registry.
 #[must_use]
 pub fn parameter_vr_of(name: &str) -> Option<u32> {
-    PARAMETERS
-        .iter()
-        .position(|p| p.name == name)
-        .map(parameter_vr)
+    parameters::parameter_vr_of(PARAMETERS, name)
 }
 
 pub use crate::diagnostics::{
@@ -97,11 +90,7 @@ impl ModelVariable for ControllerVariable {
     fn value_type(self) -> ValueType {
         match self {
             ControllerVariable::Contract(c) => c.value_type(),
-            ControllerVariable::Parameter(i) => match PARAMETERS[i].kind {
-                Kind::Real { .. } => ValueType::Real,
-                Kind::Integer { .. } => ValueType::Integer,
-                Kind::Boolean { .. } => ValueType::Boolean,
-            },
+            ControllerVariable::Parameter(i) => parameters::value_type(&PARAMETERS[i]),
             ControllerVariable::Diagnostic(d) => d.get().value_type(),
         }
     }
@@ -161,42 +150,6 @@ pub fn model_description_xml() -> String {
     DESCRIPTION.to_xml()
 }
 
-/// The model-description variable of the registry's parameter `index`: its type,
-/// unit, range and start value (the default) as the registry says.
-fn parameter_variable(index: usize) -> fmi2_slave::description::Variable {
-    let p = &PARAMETERS[index];
-    let defaults = Tuning::default();
-    let kind = match p.kind {
-        Kind::Real {
-            unit,
-            min,
-            max,
-            get,
-            ..
-        } => {
-            let mut kind = INFO.real_kind(unit, Some(get(&defaults)));
-            if let VariableKind::Real {
-                min: lo, max: hi, ..
-            } = &mut kind
-            {
-                *lo = min.value();
-                *hi = max.value();
-            }
-            kind
-        }
-        Kind::Integer { min, max, get, .. } => VariableKind::Integer {
-            declared_type: None,
-            start: Some(get(&defaults)),
-            min: Some(min),
-            max: Some(max),
-        },
-        Kind::Boolean { get, .. } => VariableKind::Boolean {
-            start: Some(get(&defaults)),
-        },
-    };
-    parameter(p.name, parameter_vr(index), kind, p.description)
-}
-
 fn build() -> ModelDescription {
     let mut v = vec![
         shared::scenario_parameter(
@@ -204,7 +157,12 @@ fn build() -> ModelDescription {
         ),
         shared::log_file_parameter(),
     ];
-    v.extend((0..PARAMETERS.len()).map(parameter_variable));
+    v.extend(
+        PARAMETERS
+            .iter()
+            .enumerate()
+            .map(|(i, p)| parameters::variable(&INFO, p, parameter_vr(i))),
+    );
 
     // Inputs: the plant's outputs; outputs: the plant's inputs.
     v.extend(shared::vessel_states(Direction::Input));
@@ -215,10 +173,7 @@ fn build() -> ModelDescription {
     v.extend(shared::commands(Direction::Output));
     // The tension commands start at the pretension `min_tension` (the command the
     // controller starts from), so their initial value is calculated from it.
-    let min_tension_vr = PARAMETERS
-        .iter()
-        .position(|p| p.name == "mpc.ship.min_tension")
-        .map(parameter_vr);
+    let min_tension_vr = parameter_vr_of("mpc.ship.min_tension");
     for var in v
         .iter_mut()
         .filter(|var| var.name.ends_with(".tension_cmd"))
@@ -240,5 +195,5 @@ fn build() -> ModelDescription {
     }
 
     v.extend(diagnostics::variables());
-    INFO.model_description(v)
+    INFO.model_description(v, &parameters::enumerations(PARAMETERS))
 }

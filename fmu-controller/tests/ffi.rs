@@ -90,7 +90,7 @@ fn outputs_hold_their_start_values_until_the_first_step() {
             VariableKind::Real { start, .. } => {
                 assert_eq!(fmu.get_real(vr), start.unwrap(), "{}", v.name);
             }
-            VariableKind::Integer { start, .. } => {
+            VariableKind::Integer { start, .. } | VariableKind::Enumeration { start, .. } => {
                 assert_eq!(fmu.get_integer(vr), start.unwrap(), "{}", v.name);
             }
             VariableKind::Boolean { start } => {

@@ -20,30 +20,22 @@ use std::sync::LazyLock;
 use towing_interface::codec::{
     ContractVariable, ModelVariable, Towline, TowlineField, VariableTable,
 };
-use towing_interface::types::real_kind;
-use towing_interface::variables::{self as shared, parameter, Direction};
+use towing_interface::parameters;
+use towing_interface::variables::{self as shared, Direction};
 use towing_interface::ModelInfo;
-use towing_model::registry::Kind;
 
-use crate::params::{PlantParams, PARAMETERS};
+use crate::params::PARAMETERS;
 
 pub use towing_interface::vr::{
     obstacle, tension_cmd, towline, tug_force, vessel_state, LOG_FILE, OBSTACLE_KIND, SCENARIO,
 };
 
-/// Value reference of the registry's parameter `index` ([`PARAMETERS`]).
-#[must_use]
-pub const fn parameter_vr(index: usize) -> u32 {
-    10 + index as u32
-}
+pub use towing_interface::parameters::parameter_vr;
 
 /// Value reference of the plant parameter `name`.
 #[must_use]
 pub fn parameter_vr_of(name: &str) -> Option<u32> {
-    PARAMETERS
-        .iter()
-        .position(|p| p.name == name)
-        .map(parameter_vr)
+    parameters::parameter_vr_of(PARAMETERS, name)
 }
 
 /// A variable of the plant, as its getters and setters see it.
@@ -67,11 +59,7 @@ impl ModelVariable for PlantVariable {
     fn value_type(self) -> ValueType {
         match self {
             PlantVariable::Contract(c) => c.value_type(),
-            PlantVariable::Parameter(i) => match PARAMETERS[i].kind {
-                Kind::Real { .. } => ValueType::Real,
-                Kind::Integer { .. } => ValueType::Integer,
-                Kind::Boolean { .. } => ValueType::Boolean,
-            },
+            PlantVariable::Parameter(i) => parameters::value_type(&PARAMETERS[i]),
         }
     }
 
@@ -112,41 +100,6 @@ pub const MODEL_IDENTIFIER: &str = "TowingPlant";
 /// The plant's model description, built once.
 pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(build);
 
-/// The model-description variable of the registry's parameter `index`.
-fn parameter_variable(index: usize) -> fmi2_slave::description::Variable {
-    let p = &PARAMETERS[index];
-    let defaults = PlantParams::default();
-    let kind = match p.kind {
-        Kind::Real {
-            unit,
-            min,
-            max,
-            get,
-            ..
-        } => {
-            let mut kind = real_kind(unit, Some(get(&defaults)));
-            if let VariableKind::Real {
-                min: lo, max: hi, ..
-            } = &mut kind
-            {
-                *lo = min.value();
-                *hi = max.value();
-            }
-            kind
-        }
-        Kind::Integer { min, max, get, .. } => VariableKind::Integer {
-            declared_type: None,
-            start: Some(get(&defaults)),
-            min: Some(min),
-            max: Some(max),
-        },
-        Kind::Boolean { get, .. } => VariableKind::Boolean {
-            start: Some(get(&defaults)),
-        },
-    };
-    parameter(p.name, parameter_vr(index), kind, p.description)
-}
-
 fn build() -> ModelDescription {
     let mut v = vec![
         shared::scenario_parameter(
@@ -154,7 +107,12 @@ fn build() -> ModelDescription {
         ),
         shared::log_file_parameter(),
     ];
-    v.extend((0..PARAMETERS.len()).map(parameter_variable));
+    v.extend(
+        PARAMETERS
+            .iter()
+            .enumerate()
+            .map(|(i, p)| parameters::variable(&INFO, p, parameter_vr(i))),
+    );
     v.extend(shared::commands(Direction::Input));
     v.extend(shared::vessel_states(Direction::Output));
     for line in Towline::ALL {
@@ -170,5 +128,5 @@ fn build() -> ModelDescription {
         ));
     }
     v.extend(shared::obstacles(Direction::Output));
-    INFO.model_description(v)
+    INFO.model_description(v, &parameters::enumerations(PARAMETERS))
 }

@@ -109,9 +109,12 @@ fn enumerations_markdown(md: &ModelDescription) -> String {
         let items: Vec<String> = t
             .items()
             .iter()
-            .map(|i| format!("{} `{}` ({})", i.value, i.name, md_escape(&i.description)))
+            .map(|i| match i.description.as_str() {
+                "" => format!("{} `{}`", i.value, i.name),
+                d => format!("{} `{}`: {}", i.value, i.name, md_escape(d)),
+            })
             .collect();
-        out.push_str(&format!("- `{}`: {}\n", t.name, items.join(", ")));
+        out.push_str(&format!("- `{}`: {}\n", t.name, items.join("; ")));
     }
     out
 }
@@ -249,7 +252,7 @@ mod tests {
             "{text}"
         );
         assert!(
-            text.contains("- `Method`: 1 `euler` (explicit Euler), 2 `heun` (a \\| b)\n"),
+            text.contains("- `Method`: 1 `euler`: explicit Euler; 2 `heun`: a \\| b\n"),
             "{text}"
         );
         // Without an Enumeration type, no list.

@@ -14,6 +14,9 @@
 //!   that reads them), and the generic parameter/input/output builders.
 //! * [`types`]: the units and declared types, and the model-description skeleton
 //!   ([`ModelInfo`]).
+//! * [`parameters`]: an FMU's parameter registry as FMI variables (value references,
+//!   types, model-description variables, Enumeration types, the values as JSON), for
+//!   both FMUs.
 //! * [`scenario`]: the `scenario` String parameter (a file path, or the bundled
 //!   `resources/paper.toml`).
 //! * [`session`]: the scenario and log life cycle both FMUs share ([`RunSession`]): the
@@ -29,6 +32,7 @@
 #![warn(missing_docs)]
 
 pub mod codec;
+pub mod parameters;
 pub mod scenario;
 pub mod session;
 pub mod types;

@@ -22,8 +22,9 @@ pub struct LogHeader<'a> {
     pub version: &'a str,
     /// `fmi2SetupExperiment`'s start time (s).
     pub start_time: f64,
-    /// Every parameter's value, a JSON object.
-    pub parameters: serde_json::Value,
+    /// The value of every parameter of the FMU's registry
+    /// ([`crate::parameters::values_json`]); the session adds its own.
+    pub parameters: serde_json::Map<String, serde_json::Value>,
 }
 
 /// The `scenario` and `log_file` parameters of an FMU instance, the scenario they loaded
@@ -131,6 +132,9 @@ impl RunSession {
             .loaded
             .as_ref()
             .ok_or_else(|| "no scenario is loaded".to_owned())?;
+        let mut parameters = header.parameters;
+        parameters.insert("scenario".into(), self.scenario_parameter.as_str().into());
+        parameters.insert("log_file".into(), self.log_file.as_str().into());
         let info = RunInfo {
             unit: header.unit,
             guid: header.guid,
@@ -138,7 +142,7 @@ impl RunSession {
             scenario: &self.scenario_parameter,
             scenario_name: &loaded.scenario.name,
             start_time: header.start_time,
-            parameters: header.parameters,
+            parameters: serde_json::Value::Object(parameters),
             scenario_text: &loaded.text,
         };
         self.log = SharedLog::open(&self.log_file, LogOptions::default(), &info, setup)
@@ -204,7 +208,7 @@ mod tests {
             guid: "{0}",
             version: "0",
             start_time: 0.0,
-            parameters: serde_json::json!({}),
+            parameters: serde_json::Map::new(),
         };
         session.open_log(&logger, header, |_| Ok(())).unwrap();
         assert!(!session.log().is_active());
@@ -220,7 +224,7 @@ mod tests {
             guid: "{0}",
             version: "0",
             start_time: 0.0,
-            parameters: serde_json::json!({}),
+            parameters: serde_json::Map::new(),
         };
         let e = session.open_log(&Logger::silent("s"), header, |_| Ok(()));
         assert_eq!(e, Err("no scenario is loaded".to_owned()));
