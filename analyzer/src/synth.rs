@@ -317,6 +317,7 @@ impl SynthRun {
                 version: "synthetic",
                 scenario: "synthetic",
                 scenario_name: &self.name,
+                run_id: "synthetic",
                 start_time: 0.0,
                 parameters: params.clone(),
                 scenario_text: text,

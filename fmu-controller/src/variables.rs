@@ -13,7 +13,7 @@
 //!
 //! | range | what |
 //! |---|---|
-//! | 1, 2 | the String parameters `scenario` and `log_file` |
+//! | 1, 2, 3 | the session's String parameters `scenario`, `log_file`, `run_id` ([`towing_interface::session::PARAMETERS`]) |
 //! | 10..=99 | the parameters of the registry ([`towing_control::params::PARAMETERS`], `10 + index`, whatever their type) |
 //! | 100..=1079 | the connected variables of `towing-interface` (vessel states, commands, towlines, obstacle slots) |
 //! | 3000.. | diagnostics ([`crate::diagnostics`]) |
@@ -29,15 +29,15 @@ use towing_control::params::PARAMETERS;
 use towing_interface::codec::{
     ContractVariable, ModelVariable, Towline, TowlineField, VariableTable,
 };
-use towing_interface::parameters;
 use towing_interface::variables::{self as shared, calculated_output, Direction};
-use towing_interface::{ModelInfo, RealType};
+use towing_interface::{parameters, session, vr, ModelInfo, RealType};
 
 /// The model identifier (binary name).
 pub const MODEL_IDENTIFIER: &str = "TowingController";
 
 pub use towing_interface::vr::{
-    obstacle, tension_cmd, towline, tug_force, vessel_state, LOG_FILE, OBSTACLE_KIND, SCENARIO,
+    obstacle, tension_cmd, towline, tug_force, vessel_state, LOG_FILE, OBSTACLE_KIND, RUN_ID,
+    SCENARIO,
 };
 
 pub use towing_interface::parameters::parameter_vr;
@@ -72,6 +72,8 @@ pub enum ControllerVariable {
     /// A variable of the interface contract: the controller declares every one but the
     /// plant's `towlineN.slack` (the measurements as inputs, the commands as outputs).
     Contract(ContractVariable),
+    /// A parameter of the session: its index in [`session::PARAMETERS`].
+    Session(usize),
     /// A parameter: its index in the registry ([`PARAMETERS`]).
     Parameter(usize),
     /// A diagnostic output.
@@ -82,6 +84,7 @@ impl ModelVariable for ControllerVariable {
     fn value_reference(self) -> u32 {
         match self {
             ControllerVariable::Contract(c) => c.encode(),
+            ControllerVariable::Session(i) => vr::session_parameter(i),
             ControllerVariable::Parameter(i) => parameter_vr(i),
             ControllerVariable::Diagnostic(d) => d.get().value_reference,
         }
@@ -90,6 +93,7 @@ impl ModelVariable for ControllerVariable {
     fn value_type(self) -> ValueType {
         match self {
             ControllerVariable::Contract(c) => c.value_type(),
+            ControllerVariable::Session(i) => parameters::value_type(&session::PARAMETERS[i]),
             ControllerVariable::Parameter(i) => parameters::value_type(&PARAMETERS[i]),
             ControllerVariable::Diagnostic(d) => d.get().value_type(),
         }
@@ -109,9 +113,13 @@ pub static VARIABLES: LazyLock<VariableTable<ControllerVariable>> = LazyLock::ne
     let contract = ContractVariable::all()
         .filter(|c| !matches!(c, ContractVariable::Towline(_, TowlineField::Slack)))
         .map(V::Contract);
+    let session = (0..session::PARAMETERS.len()).map(V::Session);
     let parameters = (0..PARAMETERS.len()).map(V::Parameter);
     let outputs = (0..DIAGNOSTICS.len()).map(|i| V::Diagnostic(DiagnosticId(i)));
-    VariableTable::new(MODEL_IDENTIFIER, contract.chain(parameters).chain(outputs))
+    VariableTable::new(
+        MODEL_IDENTIFIER,
+        contract.chain(session).chain(parameters).chain(outputs),
+    )
 });
 
 /// The controller's model-description header: the Real types of the interface, plus those
@@ -151,18 +159,7 @@ pub fn model_description_xml() -> String {
 }
 
 fn build() -> ModelDescription {
-    let mut v = vec![
-        shared::scenario_parameter(
-            "Path of the scenario file (TOML, docs/scenario-format.md) giving the prediction models, formation, route and waterway; empty: the bundled paper scenario resources/paper.toml. Use the plant's scenario.",
-        ),
-        shared::log_file_parameter(),
-    ];
-    v.extend(
-        PARAMETERS
-            .iter()
-            .enumerate()
-            .map(|(i, p)| parameters::variable(&INFO, p, parameter_vr(i))),
-    );
+    let mut v = parameters::variables(&INFO, PARAMETERS);
 
     // Inputs: the plant's outputs; outputs: the plant's inputs.
     v.extend(shared::vessel_states(Direction::Input));

@@ -237,6 +237,11 @@ fn a_missing_scenario_file_is_named() {
     testing::assert_missing_scenario_file_is_named(exports(), &DESCRIPTION);
 }
 
+#[test]
+fn run_id_is_kept_and_a_control_character_refused() {
+    testing::assert_run_id_is_kept_and_checked(exports(), &DESCRIPTION);
+}
+
 /// With h = 0.1 and T_s = 1 s the tensions hold over the 10 steps of a sample and the
 /// counter counts samples, not steps.
 #[test]

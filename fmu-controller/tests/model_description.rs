@@ -160,8 +160,8 @@ fn parameter_start_values_are_the_rust_defaults() {
         .iter()
         .filter(|v| v.causality == Causality::Parameter)
         .count();
-    // 2 String + every registry entry.
-    assert_eq!(n_params, 2 + towing_control::PARAMETERS.len());
+    // The session's 3 Strings + every registry entry.
+    assert_eq!(n_params, 3 + towing_control::PARAMETERS.len());
 }
 
 /// Every name a master connects by must exist in both FMUs with the same type and unit.

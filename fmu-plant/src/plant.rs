@@ -220,6 +220,9 @@ impl Fmi2Model for Plant {
             PlantVariable::Contract(c) => real_output(self.world(), c).ok_or_else(|| {
                 vars::VARIABLES.unhandled(ValueType::Real, PlantVariable::Contract(c), "get")
             })?,
+            other @ PlantVariable::Session(_) => {
+                return Err(vars::VARIABLES.unhandled(ValueType::Real, other, "get"))
+            }
         })
     }
 
@@ -292,28 +295,21 @@ impl Fmi2Model for Plant {
 
     fn get_string(&self, vr: u32) -> Result<String, String> {
         match vars::VARIABLES.decode(ValueType::String, vr)? {
-            PlantVariable::Contract(ContractVariable::Scenario) => {
-                Ok(self.session.scenario_parameter().to_owned())
-            }
-            PlantVariable::Contract(ContractVariable::LogFile) => {
-                Ok(self.session.log_file().to_owned())
-            }
+            PlantVariable::Session(i) => Ok(self.session.parameter(i)),
             other => Err(vars::VARIABLES.unhandled(ValueType::String, other, "get")),
         }
     }
 
+    /// A session parameter; a new `scenario` during initialization rebuilds the world (and
+    /// is undone when that fails).
     fn set_string(&mut self, log: &Logger, vr: u32, value: &str) -> Result<(), String> {
         match vars::VARIABLES.decode(ValueType::String, vr)? {
-            PlantVariable::Contract(ContractVariable::Scenario) => {
-                let previous = self.session.replace_scenario_parameter(value);
-                self.reload_if_initializing(log).inspect_err(|_| {
+            PlantVariable::Session(i) => match self.session.set_parameter(i, value)? {
+                Some(previous) => self.reload_if_initializing(log).inspect_err(|_| {
                     self.session.replace_scenario_parameter(&previous);
-                })
-            }
-            PlantVariable::Contract(ContractVariable::LogFile) => {
-                self.session.set_log_file(value);
-                Ok(())
-            }
+                }),
+                None => Ok(()),
+            },
             _ => Err(format!("value reference {vr} is not a settable String")),
         }
     }

@@ -74,6 +74,11 @@ fn without_resources_and_scenario_initialization_is_refused_with_a_reason() {
 }
 
 #[test]
+fn run_id_is_kept_and_a_control_character_refused() {
+    testing::assert_run_id_is_kept_and_checked(exports(), &DESCRIPTION);
+}
+
+#[test]
 fn wrong_guid_gives_null_and_says_why() {
     let log = Fmu::try_new_with_guid(exports(), "{not-the-guid}", "g", None, false).unwrap_err();
     let text: String = log.iter().map(|m| m.text.clone()).collect();

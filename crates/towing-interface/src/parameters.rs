@@ -1,18 +1,23 @@
 //! An FMU's parameter registry ([`towing_model::registry`]) as FMI variables, written once
 //! for both FMUs: the value reference of each entry, the FMI type it is set and read with,
-//! its model-description variable, the Enumeration types it declares, and its values as
-//! the JSON object of a log's run description.
+//! its model-description variable, the Enumeration types it declares, its values as the
+//! JSON object of a log's run description, and its documentation. An FMU's parameters are
+//! the session's ([`crate::session::PARAMETERS`]: `scenario`, `log_file`, `run_id`) and its
+//! own registry's, in this order ([`variables`], [`enumerations`], [`markdown`]).
 //!
-//! Value references: parameter `index` of an FMU's registry has `10 + index`, whatever its
-//! type ([`parameter_vr`]); below 100, so unique across the FMI types together with the
-//! contract's (crate [`vr`](crate::vr)).
+//! Value references: the session's parameter `index` has `1 + index`
+//! ([`crate::vr::session_parameter`]); parameter `index` of an FMU's registry has
+//! `10 + index`, whatever its type ([`parameter_vr`]); below 100, so unique across the FMI
+//! types together with the contract's (crate [`vr`](crate::vr)).
 
 use fmi2_slave::description::{EnumerationItem, SimpleType, Variable, VariableKind};
 use fmi2_slave::ValueType;
-use towing_model::registry::{Enumeration, Kind, Parameter, Value};
+use towing_model::registry::{self, Enumeration, Kind, Parameter, Value};
 
+use crate::session;
 use crate::types::ModelInfo;
 use crate::variables::parameter;
+use crate::vr;
 
 /// Value reference of the first parameter of an FMU's registry.
 pub const FIRST_PARAMETER_VR: u32 = 10;
@@ -93,19 +98,45 @@ pub fn variable<T: Default>(info: &ModelInfo, p: &Parameter<T>, vr: u32) -> Vari
     parameter(p.name, vr, kind, p.description)
 }
 
-/// The Enumeration types `registry`'s parameters declare, each once, in order of first
-/// use.
+/// The model-description variables of an FMU's parameters: the session's (value
+/// references 1, 2, 3), then `registry`'s (`10 + index`).
+#[must_use]
+pub fn variables<T: Default>(info: &ModelInfo, registry: &[Parameter<T>]) -> Vec<Variable> {
+    let session = session::PARAMETERS
+        .iter()
+        .enumerate()
+        .map(|(i, p)| variable(info, p, vr::session_parameter(i)));
+    let own = registry
+        .iter()
+        .enumerate()
+        .map(|(i, p)| variable(info, p, parameter_vr(i)));
+    session.chain(own).collect()
+}
+
+/// The Enumeration types an FMU's parameters (the session's and `registry`'s) declare,
+/// each once, in order of first use.
 #[must_use]
 pub fn enumerations<T>(registry: &[Parameter<T>]) -> Vec<&'static Enumeration> {
     let mut out: Vec<&'static Enumeration> = Vec::new();
-    for p in registry {
-        if let Kind::Enumeration { enumeration, .. } = p.kind {
-            if !out.iter().any(|e| e.name == enumeration.name) {
-                out.push(enumeration);
-            }
+    let kinds = session::PARAMETERS
+        .iter()
+        .map(|p| p.kind.enumeration())
+        .chain(registry.iter().map(|p| p.kind.enumeration()));
+    for enumeration in kinds.flatten() {
+        if !out.iter().any(|e| e.name == enumeration.name) {
+            out.push(enumeration);
         }
     }
     out
+}
+
+/// The documentation of an FMU's parameters (the session's, then `registry`'s): the
+/// tables of `docs/interface.md` ([`registry::markdown_of`]).
+#[must_use]
+pub fn markdown<T: Default>(registry: &[Parameter<T>]) -> String {
+    let mut rows = registry::doc_rows(session::PARAMETERS);
+    rows.extend(registry::doc_rows(registry));
+    registry::markdown_of(&rows)
 }
 
 /// The `SimpleType` of `enumeration` (FMI 2.0 section 2.2.3): its items with their values
@@ -357,6 +388,35 @@ mod tests {
                 "a.speed": 1.5, "a.count": 3, "a.on": true, "a.mode": 1, "b.mode": 1,
                 "a.label": "x"
             })
+        );
+    }
+
+    #[test]
+    fn an_fmus_parameters_are_the_sessions_then_its_own() {
+        let vars = variables(&INFO, REGISTRY);
+        let names: Vec<(&str, u32, ValueType)> = vars
+            .iter()
+            .map(|v| (v.name.as_str(), v.value_reference, v.value_type()))
+            .collect();
+        assert_eq!(
+            names[..4],
+            [
+                ("scenario", 1, ValueType::String),
+                ("log_file", 2, ValueType::String),
+                ("run_id", 3, ValueType::String),
+                ("a.speed", 10, ValueType::Real),
+            ]
+        );
+        assert_eq!(vars.len(), 3 + REGISTRY.len());
+        let doc = markdown(REGISTRY);
+        let at = |s: &str| {
+            doc.find(s)
+                .unwrap_or_else(|| panic!("{s} missing in {doc}"))
+        };
+        assert!(at("| `scenario` | String |") < at("| `a.speed` | Real |"));
+        assert!(
+            doc.contains("| `run_id` | String |  | text | \"\" |"),
+            "{doc}"
         );
     }
 }

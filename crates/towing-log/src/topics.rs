@@ -136,6 +136,9 @@ pub mod metadata_keys {
     pub const SCENARIO: &str = "scenario";
     /// The scenario's name.
     pub const SCENARIO_NAME: &str = "scenario_name";
+    /// The run's identifier (the FMUs' `run_id` parameter), empty when none was given;
+    /// absent from logs written before it existed (read as empty).
+    pub const RUN_ID: &str = "run_id";
     /// Always [`super::EPOCH`].
     pub const EPOCH: &str = "epoch";
     /// Start time of the run (simulation time, s).

@@ -520,6 +520,9 @@ pub struct RunInfo<'a> {
     pub scenario: &'a str,
     /// The scenario's name.
     pub scenario_name: &'a str,
+    /// The run's identifier (the FMUs' `run_id` parameter; empty: none given): the same in
+    /// the plant's and the controller's log of one run.
+    pub run_id: &'a str,
     /// Start time of the run (simulation time, s).
     pub start_time: f64,
     /// Every parameter's value, a JSON object.
@@ -546,6 +549,7 @@ impl LogWriter {
             (k::VERSION, info.version.to_owned()),
             (k::SCENARIO, scenario.to_owned()),
             (k::SCENARIO_NAME, info.scenario_name.to_owned()),
+            (k::RUN_ID, info.run_id.to_owned()),
             (k::EPOCH, t::EPOCH.to_owned()),
             (k::START_TIME, format!("{}", info.start_time)),
             (k::PARAMETERS, info.parameters.to_string()),

@@ -485,6 +485,7 @@ fn run_metadata_and_the_scenario_attachment() {
         version: "0.1.0",
         scenario: "",
         scenario_name: "paper",
+        run_id: "run 42",
         start_time: 0.0,
         parameters: serde_json::json!({"hull_model": 0, "scenario": ""}),
         scenario_text: "name = \"paper\"\n",
@@ -500,6 +501,7 @@ fn run_metadata_and_the_scenario_attachment() {
     assert_eq!(m["scenario"], topics::BUNDLED_SCENARIO_LABEL);
     assert_eq!(m["epoch"], "simulation time 0 s");
     assert_eq!(m["start_time"], "0");
+    assert_eq!(m["run_id"], "run 42");
     let params: serde_json::Value = serde_json::from_str(&m["parameters"]).unwrap();
     assert_eq!(params["hull_model"], 0);
     for key in ["guid", "version", "scenario_name"] {

@@ -350,6 +350,17 @@ fn range_text(min: Limit, max: Limit, unit: &str) -> String {
     }
 }
 
+impl<T> Kind<T> {
+    /// The Enumeration type of an Enumeration parameter.
+    #[must_use]
+    pub fn enumeration(&self) -> Option<&'static Enumeration> {
+        match self {
+            Kind::Enumeration { enumeration, .. } => Some(enumeration),
+            _ => None,
+        }
+    }
+}
+
 impl<T> Clone for Kind<T> {
     fn clone(&self) -> Self {
         *self
