@@ -178,7 +178,7 @@ pub fn values_json<T>(
 mod tests {
     use super::*;
     use fmi2_slave::description::{Causality, Variability};
-    use towing_model::registry::{Item, Limit};
+    use towing_model::registry::Limit;
 
     struct Holder {
         speed: f64,
@@ -200,22 +200,7 @@ mod tests {
         }
     }
 
-    const MODE: Enumeration = Enumeration {
-        name: "Mode",
-        description: "how to go",
-        items: &[
-            Item {
-                name: "slow",
-                value: 1,
-                description: "slowly",
-            },
-            Item {
-                name: "fast",
-                value: 2,
-                description: "quickly",
-            },
-        ],
-    };
+    const HULL: &Enumeration = &towing_model::HullModel::ENUMERATION;
 
     const REGISTRY: &[Parameter<Holder>] = &[
         Parameter {
@@ -255,17 +240,17 @@ mod tests {
             old_name: None,
             description: "mode",
             kind: Kind::Enumeration {
-                enumeration: &MODE,
+                enumeration: HULL,
                 get: |h| h.mode,
                 set: |h, v| h.mode = v,
             },
         },
         Parameter {
-            name: "b.mode",
+            name: "b.hull",
             old_name: None,
             description: "the same type again",
             kind: Kind::Enumeration {
-                enumeration: &MODE,
+                enumeration: HULL,
                 get: |h| h.mode,
                 set: |h, v| h.mode = v,
             },
@@ -330,7 +315,7 @@ mod tests {
         assert_eq!(
             vars[3].kind,
             VariableKind::Enumeration {
-                declared_type: "Mode".to_owned(),
+                declared_type: "HullModel".to_owned(),
                 start: Some(2),
             }
         );
@@ -349,17 +334,17 @@ mod tests {
     #[test]
     fn enumeration_types_are_declared_once_and_make_a_valid_description() {
         let types = enumerations(REGISTRY);
-        assert_eq!(types.len(), 1, "a.mode and b.mode share Mode");
+        assert_eq!(types.len(), 1, "a.mode and b.hull share HullModel");
         let t = simple_type(types[0]);
-        assert_eq!(t.name, "Mode");
-        assert_eq!(t.description, "how to go");
-        assert_eq!(
-            t.items(),
-            [
-                EnumerationItem::new("slow", 1, "slowly"),
-                EnumerationItem::new("fast", 2, "quickly")
-            ]
-        );
+        assert_eq!(t.name, "HullModel");
+        assert_eq!(t.description, HULL.description);
+        let items: Vec<(&str, i32)> = t
+            .items()
+            .iter()
+            .map(|i| (i.name.as_str(), i.value))
+            .collect();
+        assert_eq!(items, [("linear_damping", 1), ("nonlinear_damping", 2)]);
+        assert_eq!(t.items()[1].description, HULL.items[1].description);
         let vars = REGISTRY
             .iter()
             .enumerate()
@@ -369,10 +354,10 @@ mod tests {
         assert_eq!(md.validate(), Ok(()));
         assert!(md
             .to_xml()
-            .contains("<Enumeration declaredType=\"Mode\" start=\"2\"/>"));
+            .contains("<Enumeration declaredType=\"HullModel\" start=\"2\"/>"));
         // Without the type the description is refused: the builder checks the link.
         let md = INFO.model_description(md.variables.clone(), &[]);
-        assert!(md.validate().unwrap_err()[0].contains("declaredType 'Mode' is not defined"));
+        assert!(md.validate().unwrap_err()[0].contains("declaredType 'HullModel' is not defined"));
     }
 
     #[test]
@@ -385,7 +370,7 @@ mod tests {
         assert_eq!(
             json,
             serde_json::json!({
-                "a.speed": 1.5, "a.count": 3, "a.on": true, "a.mode": 1, "b.mode": 1,
+                "a.speed": 1.5, "a.count": 3, "a.on": true, "a.mode": 1, "b.hull": 1,
                 "a.label": "x"
             })
         );
