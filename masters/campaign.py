@@ -46,8 +46,8 @@ DEFAULTS = {"stop_time": "arrival", "step": 0.1, "wall_time_limit_s": 600.0, "ke
 # arrival verdict (its thresholds arrival_speed_m_s and arrival_margin_s, which a
 # [thresholds] table may change, and then changes here too).
 ARRIVAL_SPEED, ARRIVAL_MARGIN = 0.05, 300.0
-# Parameters the campaign sets itself on both FMUs.
-RESERVED = {"scenario", "log_file"}
+# Parameters the campaign sets itself on both FMUs (run_id: the run's id, in both logs).
+RESERVED = {"scenario", "log_file", "run_id"}
 FMI_TYPES = ("Real", "Integer", "Enumeration", "Boolean", "String")
 
 
@@ -125,7 +125,7 @@ def _parameters(table, path):
         if len({json.dumps(v) for v in values}) != len(values):
             raise CampaignError(f"{where}: repeated value in {values!r}")
         if name.removeprefix("plant.") in RESERVED:
-            raise CampaignError(f"{where}: set by the campaign itself (the scenario file and the run's logs)")
+            raise CampaignError(f"{where}: set by the campaign itself (the scenario file, the run's logs and id)")
     return dict(table)
 
 
@@ -192,19 +192,25 @@ def random_files(c, out):
 
 
 def fmu_parameters(fmu):
-    """{name: (FMI type, min, max)} of the FMU's parameters, from the modelDescription.xml
-    inside it (min and max None when not given)."""
+    """{name: (FMI type, min, max, items)} of the FMU's parameters, from the
+    modelDescription.xml inside it (min and max None when not given; items, for an
+    Enumeration, the [(value, name)] of its declared type, FMI 2.0 section 2.2.3)."""
     try:
         with zipfile.ZipFile(fmu) as z:
             root = ET.fromstring(z.read("modelDescription.xml"))
     except (OSError, KeyError, zipfile.BadZipFile, ET.ParseError) as e:
         raise CampaignError(f"{fmu}: cannot read its modelDescription.xml: {e}") from None
+    enumerations = {
+        t.get("name"): [(int(i.get("value")), i.get("name")) for i in t.iter("Item")]
+        for t in root.iter("SimpleType") if t.find("Enumeration") is not None
+    }
     out = {}
     for v in root.iter("ScalarVariable"):
         if v.get("causality") == "parameter":
             types = [child for child in v if child.tag in FMI_TYPES]
             bound = lambda key: float(types[0].get(key)) if types and types[0].get(key) is not None else None  # noqa: E731
-            out[v.get("name")] = (types[0].tag if types else None, bound("min"), bound("max"))
+            items = enumerations.get(types[0].get("declaredType")) if types and types[0].tag == "Enumeration" else None
+            out[v.get("name")] = (types[0].tag if types else None, bound("min"), bound("max"), items)
     return out
 
 
@@ -213,7 +219,7 @@ def check_parameters(c, plant, controller):
     fmus = {"controller": fmu_parameters(controller), "plant": fmu_parameters(plant)}
     for name, values in c["parameters"].items():
         side, fmi = ("plant", name[len("plant."):]) if name.startswith("plant.") else ("controller", name)
-        kind, low, high = fmus[side].get(fmi, ("missing", None, None))
+        kind, low, high, items = fmus[side].get(fmi, ("missing", None, None, None))
         if kind == "missing":
             raise CampaignError(f"{c['file']}: [parameters] {name}: the {side} FMU has no parameter '{fmi}' "
                                 f"(its parameters: {', '.join(sorted(fmus[side]))})")
@@ -227,6 +233,12 @@ def check_parameters(c, plant, controller):
         bad = [v for v in values if not ok(v)]
         if bad:
             raise CampaignError(f"{c['file']}: [parameters] {name}: {side} parameter '{fmi}' is {kind}, got {bad[0]!r}")
+        if items is not None:
+            unknown = [v for v in values if v not in {value for value, _ in items}]
+            if unknown:
+                choices = ", ".join(f"{value} {name}" for value, name in items)
+                raise CampaignError(f"{c['file']}: [parameters] {name}: {side} parameter '{fmi}' must be one of {choices} "
+                                    f"(its modelDescription), got {unknown[0]!r}")
         outside = [v for v in values if not isinstance(v, (bool, str)) and ((low is not None and v < low) or (high is not None and v > high))]
         if outside:
             raise CampaignError(f"{c['file']}: [parameters] {name}: {side} parameter '{fmi}' must be in [{'-inf' if low is None else f'{low:g}'}, {'inf' if high is None else f'{high:g}'}] "

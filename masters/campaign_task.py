@@ -183,7 +183,7 @@ def simulate(spec_path):
 
     argv = ["--plant", str(pathlib.Path(spec["base"]) / PLANT), "--controller", str(pathlib.Path(spec["base"]) / CONTROLLER),
             "--scenario", spec["scenario"], "--stop-time", repr(float(spec["stop_time"])), "--step", repr(float(spec["step"])),
-            "--log-dir", str(run_dir / "logs"), "--quiet"]
+            "--log-dir", str(run_dir / "logs"), "--run-id", spec["id"], "--quiet"]
     for name, value in spec["parameters"].items():
         if name.startswith("plant."):
             argv += ["--plant-param", f"{name[len('plant.'):]}={fmi_text(value)}"]

@@ -38,11 +38,14 @@ Options:
     --architecture {1,2}            1 distributed (ADMM), 2 centralized
     --scheme {1,2,3}                avoidance scheme I, II, III of Du et al. (2022)
     --param NAME=VALUE              any controller parameter, typed from its
-                                    modelDescription (repeatable)
+                                    modelDescription (repeatable); an Enumeration takes
+                                    its value or an item's name (architecture=centralized)
     --plant-param NAME=VALUE        the same for the plant (e.g. model.hull_from_scenario=false)
     --coupling {gauss-seidel,jacobi}  order of a communication step (default gauss-seidel)
     --log-dir DIR                   MCAP logs (docs/logging.md): sets `log_file` to
                                     DIR/plant.mcap and DIR/controller.mcap (created)
+    --run-id ID                     set as `run_id` on both FMUs, so both logs name the
+                                    same run (default: a new one, UTC time + random hex)
     --out DIR (out/closed-loop), --map-size WxH (pixels, 1400x1200), --quiet
 
 Writes:
@@ -59,7 +62,7 @@ Writes:
     DIR/summary.json    stop time, wall time (and the master thread's CPU time) of the
                         stepping loop, steps, fallbacks, warnings, compute time and
                         ADMM iteration statistics over the controller samples, final ship pose,
-                        the log files (with --log-dir).
+                        the run id, the log files (with --log-dir).
     LOG/plant.mcap, LOG/controller.mcap   with --log-dir LOG; open both in Foxglove
                         (docs/foxglove.md).
 
@@ -78,6 +81,7 @@ import shutil
 import sys
 import tempfile
 import time
+import uuid
 
 import fmpy
 import numpy as np
@@ -247,8 +251,10 @@ class Unit:
         try:
             if v.type == "Real":
                 self.slave.setReal(vr, [float(text)])
-            elif v.type in ("Integer", "Enumeration"):
+            elif v.type == "Integer":
                 self.slave.setInteger(vr, [int(text)])
+            elif v.type == "Enumeration":
+                self.slave.setInteger(vr, [enumeration_value(v, text)])
             elif v.type == "Boolean":
                 low = str(text).lower()
                 if low not in ("true", "false", "1", "0"):
@@ -320,11 +326,15 @@ def run(args, log):
             receiver.prepare_inputs(by_type)
             receiver.gather = {t: np.array([sender.out_names[t].index(n) for n in by_type[t]], dtype=np.intp) for t in TYPES}
 
-        # Parameters: scenario on both, architecture and scheme on the controller, then --param.
+        # Parameters: scenario and run_id on both, architecture and scheme on the controller,
+        # then --param.
         scenario = str(pathlib.Path(args.scenario).resolve()) if args.scenario else ""
+        run_id = args.run_id if args.run_id is not None else new_run_id()
         for u in (plant, ctrl):
             if "scenario" in u.vars:
                 u.set_parameter("scenario", scenario)
+            if "run_id" in u.vars:
+                u.set_parameter("run_id", run_id)
         if args.architecture is not None:
             ctrl.set_parameter("architecture", str(args.architecture))
         if args.scheme is not None:
@@ -423,6 +433,7 @@ def run(args, log):
         summary["architecture"] = args.architecture if args.architecture is not None else _start(ctrl, "architecture")
         summary["avoidance_scheme"] = args.scheme if args.scheme is not None else _start(ctrl, "avoidance_scheme")
         summary["coupling"] = args.coupling
+        summary["run_id"] = run_id
         if log_files:
             summary["log_files"] = log_files
         for u in units:
@@ -436,6 +447,29 @@ def run(args, log):
                 pass
         shutil.rmtree(workdir, ignore_errors=True)
         raise
+
+
+def enumeration_value(var, text):
+    """The FMI value of the Enumeration parameter `var` (FMI 2.0 section 2.2.3; set with
+    fmi2SetInteger) from its text: a value (`2`) or the name of an item of its declared type
+    (`centralized`). Raises ValueError naming the items otherwise; whether a number is an
+    item's value the FMU checks."""
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    items = getattr(getattr(var, "declaredType", None), "items", None) or []
+    for item in items:
+        if item.name == text:
+            return int(item.value)
+    names = ", ".join(f"{int(i.value)} {i.name}" for i in items)
+    raise ValueError(f"{text!r} is neither a number nor an item name ({names})")
+
+
+def new_run_id():
+    """A run id no other run has: the UTC time and 32 random bits, e.g.
+    `20250101T120000Z-1a2b3c4d`."""
+    return time.strftime("%Y%m%dT%H%M%SZ", time.gmtime()) + "-" + uuid.uuid4().hex[:8]
 
 
 def _start(unit, name):
@@ -676,6 +710,7 @@ def build_parser():
         "jacobi: both step on the other's outputs at the step's start, as libcosim and fmpy's SSP runner do",
     )
     p.add_argument("--log-dir", default=None, metavar="DIR", help="write MCAP logs DIR/plant.mcap and DIR/controller.mcap (the FMUs' `log_file` parameters; default: no logs)")
+    p.add_argument("--run-id", default=None, metavar="ID", help="the run's id, set as `run_id` on both FMUs and written into both logs (default: a new one from the UTC time and random hex)")
     p.add_argument("--out", default="out/closed-loop", metavar="DIR", help="output directory (default: out/closed-loop)")
     p.add_argument("--map-size", type=parse_size, default=(1400, 1200), metavar="WxH", help="size of map.png in pixels (default: 1400x1200)")
     p.add_argument("--quiet", action="store_true", help="no progress lines (one every 100 s of simulated time otherwise)")

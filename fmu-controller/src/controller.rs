@@ -37,7 +37,7 @@ use towing_interface::codec::{
     obstacle_kind_code, obstacle_kind_from_code, ContractVariable, ObstacleField, TowlineField,
     Vessel,
 };
-use towing_interface::{LogHeader, RunSession};
+use towing_interface::{parameters, LogHeader, RunSession};
 
 const STATE_MAGIC: &[u8; 4] = b"TWCT";
 
@@ -164,23 +164,12 @@ impl ControllerFmu {
     /// Creates the log named by `log_file` (if any) and writes the run description.
     fn open_log(&mut self, log: &Logger) -> Result<(), String> {
         let guid = vars::DESCRIPTION.guid();
-        let mut parameters = serde_json::Map::new();
-        parameters.insert("scenario".into(), self.session.scenario_parameter().into());
-        parameters.insert("log_file".into(), self.session.log_file().into());
-        for p in PARAMETERS {
-            let value = match p.get(&self.params) {
-                Value::Real(v) => v.into(),
-                Value::Integer(v) => v.into(),
-                Value::Boolean(v) => v.into(),
-            };
-            parameters.insert(p.name.into(), value);
-        }
         let header = LogHeader {
             unit: vars::MODEL_IDENTIFIER,
             guid: &guid,
             version: env!("CARGO_PKG_VERSION"),
             start_time: self.start_time,
-            parameters: serde_json::Value::Object(parameters),
+            parameters: parameters::values_json(PARAMETERS, &self.params),
         };
         self.session.open_log(log, header, logging::register_topics)
     }
@@ -274,6 +263,7 @@ impl Fmi2Model for ControllerFmu {
             V::Contract(C::TugForce(tug, c)) => Some(o.command.tug_thrust[tug.index()][c.index()]),
             V::Contract(C::TensionCmd(line)) => Some(o.command.tension[line.index()]),
             V::Contract(c) => self.inputs.real(c),
+            V::Session(_) => None,
         };
         value.ok_or_else(|| vars::VARIABLES.unhandled(ValueType::Real, variable, "get"))
     }
@@ -348,30 +338,21 @@ impl Fmi2Model for ControllerFmu {
 
     fn get_string(&self, vr: u32) -> Result<String, String> {
         match vars::VARIABLES.decode(ValueType::String, vr)? {
-            V::Contract(ContractVariable::Scenario) => {
-                Ok(self.session.scenario_parameter().to_owned())
-            }
-            V::Contract(ContractVariable::LogFile) => Ok(self.session.log_file().to_owned()),
+            V::Session(i) => Ok(self.session.parameter(i)),
             other => Err(vars::VARIABLES.unhandled(ValueType::String, other, "get")),
         }
     }
 
+    /// A session parameter; a new `scenario` during initialization is read at once (and
+    /// undone when that fails).
     fn set_string(&mut self, log: &Logger, vr: u32, value: &str) -> Result<(), String> {
         match vars::VARIABLES.decode(ValueType::String, vr)? {
-            V::Contract(ContractVariable::Scenario) => {
-                let previous = self.session.replace_scenario_parameter(value);
-                if self.initializing {
-                    if let Err(e) = self.load(log) {
-                        self.session.replace_scenario_parameter(&previous);
-                        return Err(e);
-                    }
-                }
-                Ok(())
-            }
-            V::Contract(ContractVariable::LogFile) => {
-                self.session.set_log_file(value);
-                Ok(())
-            }
+            V::Session(i) => match self.session.set_parameter(i, value)? {
+                Some(previous) if self.initializing => self.load(log).inspect_err(|_| {
+                    self.session.replace_scenario_parameter(&previous);
+                }),
+                _ => Ok(()),
+            },
             _ => Err(format!("value reference {vr} is not a settable String")),
         }
     }

@@ -13,7 +13,7 @@
 //!
 //! | range | what |
 //! |---|---|
-//! | 1, 2 | the String parameters `scenario` and `log_file` |
+//! | 1, 2, 3 | the session's String parameters `scenario`, `log_file`, `run_id` ([`towing_interface::session::PARAMETERS`]) |
 //! | 10..=99 | the parameters of the registry ([`towing_control::params::PARAMETERS`], `10 + index`, whatever their type) |
 //! | 100..=1079 | the connected variables of `towing-interface` (vessel states, commands, towlines, obstacle slots) |
 //! | 3000.. | diagnostics ([`crate::diagnostics`]) |
@@ -25,34 +25,27 @@ use crate::diagnostics::{self, DIAGNOSTICS};
 use fmi2_slave::description::{ModelDescription, VariableKind};
 use fmi2_slave::ValueType;
 use std::sync::LazyLock;
-use towing_control::params::{Kind, PARAMETERS};
-use towing_control::Tuning;
+use towing_control::params::PARAMETERS;
 use towing_interface::codec::{
     ContractVariable, ModelVariable, Towline, TowlineField, VariableTable,
 };
-use towing_interface::variables::{self as shared, calculated_output, parameter, Direction};
-use towing_interface::{ModelInfo, RealType};
+use towing_interface::variables::{self as shared, calculated_output, Direction};
+use towing_interface::{parameters, session, vr, ModelInfo, RealType};
 
 /// The model identifier (binary name).
 pub const MODEL_IDENTIFIER: &str = "TowingController";
 
 pub use towing_interface::vr::{
-    obstacle, tension_cmd, towline, tug_force, vessel_state, LOG_FILE, OBSTACLE_KIND, SCENARIO,
+    obstacle, tension_cmd, towline, tug_force, vessel_state, LOG_FILE, OBSTACLE_KIND, RUN_ID,
+    SCENARIO,
 };
 
-/// Value reference of the registry's parameter `index`.
-#[must_use]
-pub const fn parameter_vr(index: usize) -> u32 {
-    10 + index as u32
-}
+pub use towing_interface::parameters::parameter_vr;
 
 /// Value reference of the parameter `name` of the registry.
 #[must_use]
 pub fn parameter_vr_of(name: &str) -> Option<u32> {
-    PARAMETERS
-        .iter()
-        .position(|p| p.name == name)
-        .map(parameter_vr)
+    parameters::parameter_vr_of(PARAMETERS, name)
 }
 
 pub use crate::diagnostics::{
@@ -79,6 +72,8 @@ pub enum ControllerVariable {
     /// A variable of the interface contract: the controller declares every one but the
     /// plant's `towlineN.slack` (the measurements as inputs, the commands as outputs).
     Contract(ContractVariable),
+    /// A parameter of the session: its index in [`session::PARAMETERS`].
+    Session(usize),
     /// A parameter: its index in the registry ([`PARAMETERS`]).
     Parameter(usize),
     /// A diagnostic output.
@@ -89,6 +84,7 @@ impl ModelVariable for ControllerVariable {
     fn value_reference(self) -> u32 {
         match self {
             ControllerVariable::Contract(c) => c.encode(),
+            ControllerVariable::Session(i) => vr::session_parameter(i),
             ControllerVariable::Parameter(i) => parameter_vr(i),
             ControllerVariable::Diagnostic(d) => d.get().value_reference,
         }
@@ -97,11 +93,8 @@ impl ModelVariable for ControllerVariable {
     fn value_type(self) -> ValueType {
         match self {
             ControllerVariable::Contract(c) => c.value_type(),
-            ControllerVariable::Parameter(i) => match PARAMETERS[i].kind {
-                Kind::Real { .. } => ValueType::Real,
-                Kind::Integer { .. } => ValueType::Integer,
-                Kind::Boolean { .. } => ValueType::Boolean,
-            },
+            ControllerVariable::Session(i) => parameters::value_type(&session::PARAMETERS[i]),
+            ControllerVariable::Parameter(i) => parameters::value_type(&PARAMETERS[i]),
             ControllerVariable::Diagnostic(d) => d.get().value_type(),
         }
     }
@@ -120,9 +113,13 @@ pub static VARIABLES: LazyLock<VariableTable<ControllerVariable>> = LazyLock::ne
     let contract = ContractVariable::all()
         .filter(|c| !matches!(c, ContractVariable::Towline(_, TowlineField::Slack)))
         .map(V::Contract);
+    let session = (0..session::PARAMETERS.len()).map(V::Session);
     let parameters = (0..PARAMETERS.len()).map(V::Parameter);
     let outputs = (0..DIAGNOSTICS.len()).map(|i| V::Diagnostic(DiagnosticId(i)));
-    VariableTable::new(MODEL_IDENTIFIER, contract.chain(parameters).chain(outputs))
+    VariableTable::new(
+        MODEL_IDENTIFIER,
+        contract.chain(session).chain(parameters).chain(outputs),
+    )
 });
 
 /// The controller's model-description header: the Real types of the interface, plus those
@@ -161,50 +158,8 @@ pub fn model_description_xml() -> String {
     DESCRIPTION.to_xml()
 }
 
-/// The model-description variable of the registry's parameter `index`: its type,
-/// unit, range and start value (the default) as the registry says.
-fn parameter_variable(index: usize) -> fmi2_slave::description::Variable {
-    let p = &PARAMETERS[index];
-    let defaults = Tuning::default();
-    let kind = match p.kind {
-        Kind::Real {
-            unit,
-            min,
-            max,
-            get,
-            ..
-        } => {
-            let mut kind = INFO.real_kind(unit, Some(get(&defaults)));
-            if let VariableKind::Real {
-                min: lo, max: hi, ..
-            } = &mut kind
-            {
-                *lo = min.value();
-                *hi = max.value();
-            }
-            kind
-        }
-        Kind::Integer { min, max, get, .. } => VariableKind::Integer {
-            declared_type: None,
-            start: Some(get(&defaults)),
-            min: Some(min),
-            max: Some(max),
-        },
-        Kind::Boolean { get, .. } => VariableKind::Boolean {
-            start: Some(get(&defaults)),
-        },
-    };
-    parameter(p.name, parameter_vr(index), kind, p.description)
-}
-
 fn build() -> ModelDescription {
-    let mut v = vec![
-        shared::scenario_parameter(
-            "Path of the scenario file (TOML, docs/scenario-format.md) giving the prediction models, formation, route and waterway; empty: the bundled paper scenario resources/paper.toml. Use the plant's scenario.",
-        ),
-        shared::log_file_parameter(),
-    ];
-    v.extend((0..PARAMETERS.len()).map(parameter_variable));
+    let mut v = parameters::variables(&INFO, PARAMETERS);
 
     // Inputs: the plant's outputs; outputs: the plant's inputs.
     v.extend(shared::vessel_states(Direction::Input));
@@ -215,10 +170,7 @@ fn build() -> ModelDescription {
     v.extend(shared::commands(Direction::Output));
     // The tension commands start at the pretension `min_tension` (the command the
     // controller starts from), so their initial value is calculated from it.
-    let min_tension_vr = PARAMETERS
-        .iter()
-        .position(|p| p.name == "mpc.ship.min_tension")
-        .map(parameter_vr);
+    let min_tension_vr = parameter_vr_of("mpc.ship.min_tension");
     for var in v
         .iter_mut()
         .filter(|var| var.name.ends_with(".tension_cmd"))
@@ -240,5 +192,5 @@ fn build() -> ModelDescription {
     }
 
     v.extend(diagnostics::variables());
-    INFO.model_description(v)
+    INFO.model_description(v, &parameters::enumerations(PARAMETERS))
 }

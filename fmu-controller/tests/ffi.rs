@@ -90,7 +90,7 @@ fn outputs_hold_their_start_values_until_the_first_step() {
             VariableKind::Real { start, .. } => {
                 assert_eq!(fmu.get_real(vr), start.unwrap(), "{}", v.name);
             }
-            VariableKind::Integer { start, .. } => {
+            VariableKind::Integer { start, .. } | VariableKind::Enumeration { start, .. } => {
                 assert_eq!(fmu.get_integer(vr), start.unwrap(), "{}", v.name);
             }
             VariableKind::Boolean { start } => {
@@ -235,6 +235,11 @@ fn without_resources_and_scenario_initialization_is_refused_with_a_reason() {
 #[test]
 fn a_missing_scenario_file_is_named() {
     testing::assert_missing_scenario_file_is_named(exports(), &DESCRIPTION);
+}
+
+#[test]
+fn run_id_is_kept_and_a_control_character_refused() {
+    testing::assert_run_id_is_kept_and_checked(exports(), &DESCRIPTION);
 }
 
 /// With h = 0.1 and T_s = 1 s the tensions hold over the 10 steps of a sample and the

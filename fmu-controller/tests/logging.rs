@@ -125,8 +125,12 @@ fn every_sample_logs_every_topic_once() {
     let run = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).unwrap();
     assert_eq!(run.metadata["unit"], "TowingController");
     assert_eq!(run.metadata["guid"], DESCRIPTION.guid());
+    // No run_id given: no key (an analyzer reads it as empty).
+    assert!(!run.metadata.contains_key("run_id"));
     let params: serde_json::Value = serde_json::from_str(&run.metadata["parameters"]).unwrap();
     assert!(params["mpc.sample_time"].is_number(), "{params}");
+    assert_eq!(params["run_id"], "");
+    assert_eq!(params["log_file"], path.to_str().unwrap());
     assert_eq!(
         params["avoidance_scheme"],
         fmu.get_integer(vars::parameter_vr_of("avoidance_scheme").unwrap())

@@ -44,6 +44,22 @@ fn start_integer(name: &str) -> i32 {
     }
 }
 
+/// The start value and declared type of the Enumeration parameter `name`.
+fn start_enumeration(name: &str) -> (i32, &'static str) {
+    let v = DESCRIPTION
+        .variables
+        .iter()
+        .find(|v| v.name == name)
+        .unwrap();
+    match &v.kind {
+        VariableKind::Enumeration {
+            start: Some(s),
+            declared_type,
+        } => (*s, declared_type.as_str()),
+        _ => panic!("{name} is not an Enumeration with a start value"),
+    }
+}
+
 fn start_boolean(name: &str) -> bool {
     let v = DESCRIPTION
         .variables
@@ -123,8 +139,18 @@ fn parameter_start_values_are_the_rust_defaults() {
     assert!(start_boolean("waterway.from_scenario"));
     assert!(c.guidance().waterway_half_width.is_some());
 
-    assert_eq!(start_integer("architecture"), t.architecture.code());
-    assert_eq!(start_integer("avoidance_scheme"), t.scheme.code());
+    assert_eq!(
+        start_enumeration("architecture"),
+        (t.architecture.code(), "Architecture")
+    );
+    assert_eq!(
+        start_enumeration("avoidance_scheme"),
+        (t.scheme.code(), "AvoidanceScheme")
+    );
+    assert_eq!(
+        start_enumeration("mpc.hull_model"),
+        (t.hull.code(), "HullModel")
+    );
     assert_eq!(
         start_integer("admm.max_iterations"),
         i32::try_from(t.admm.max_iterations).unwrap()
@@ -134,8 +160,8 @@ fn parameter_start_values_are_the_rust_defaults() {
         .iter()
         .filter(|v| v.causality == Causality::Parameter)
         .count();
-    // 2 String + every registry entry.
-    assert_eq!(n_params, 2 + towing_control::PARAMETERS.len());
+    // The session's 3 Strings + every registry entry.
+    assert_eq!(n_params, 3 + towing_control::PARAMETERS.len());
 }
 
 /// Every name a master connects by must exist in both FMUs with the same type and unit.

@@ -14,7 +14,8 @@ use towing_controller::variables as vars;
 use towing_model::Scenario;
 
 /// Values out of a parameter's range (and non-finite ones for a Real, which the FMI
-/// layer refuses for every Real variable before the model's registry sees them).
+/// layer refuses for every Real variable before the model's registry sees them; for an
+/// Enumeration, values next to its items').
 fn invalid_values(kind: Kind) -> Vec<Value> {
     match kind {
         Kind::Real { min, max, .. } => {
@@ -32,7 +33,16 @@ fn invalid_values(kind: Kind) -> Vec<Value> {
             v.into_iter().map(Value::Real).collect()
         }
         Kind::Integer { min, max, .. } => vec![Value::Integer(min - 1), Value::Integer(max + 1)],
-        Kind::Boolean { .. } => vec![],
+        Kind::Enumeration { enumeration, .. } => {
+            let values = enumeration.items.iter().map(|i| i.value);
+            let (lo, hi) = (values.clone().min().unwrap(), values.max().unwrap());
+            vec![
+                Value::Integer(lo - 1),
+                Value::Integer(hi + 1),
+                Value::Integer(0),
+            ]
+        }
+        Kind::Boolean { .. } | Kind::String { .. } => vec![],
     }
 }
 
@@ -43,7 +53,7 @@ fn every_value_the_fmu_refuses_the_rust_api_refuses_with_the_same_reason() {
         for value in invalid_values(p.kind) {
             let mut config = ControllerConfig::new(Scenario::paper().unwrap());
             let reason = config
-                .set(p.name, value)
+                .set(p.name, value.clone())
                 .expect_err(&format!("{} = {value:?} accepted", p.name))
                 .to_string();
             let fmu = controller(p.name);
@@ -52,6 +62,7 @@ fn every_value_the_fmu_refuses_the_rust_api_refuses_with_the_same_reason() {
                 Value::Real(v) => fmu.set_real(vr, v),
                 Value::Integer(v) => fmu.set_integer(vr, v),
                 Value::Boolean(v) => fmu.set_boolean(vr, v),
+                Value::String(ref v) => fmu.set_string(vr, v),
             };
             assert_eq!(status, Fmi2Status::Error, "{} = {value:?}", p.name);
             if matches!(value, Value::Real(v) if !v.is_finite()) {

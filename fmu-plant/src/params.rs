@@ -6,12 +6,69 @@
 //! |---|---|
 //! | `model` | the physics: hull damping, towline model, integration step, each from the scenario's `[simulation]` section unless switched off |
 //! | `log` | the MCAP log's Foxglove scene topics |
+//!
+//! A choice is an FMI Enumeration whose items keep the codes masters have always set:
+//! `model.hull` ([`HullModel::ENUMERATION`]), `model.towline`
+//! ([`TowlineChoice::ENUMERATION`]).
 
-use towing_model::registry::{self, Kind, Limit};
+use towing_model::registry::{self, Enumeration, Item, Kind, Limit};
 use towing_model::{HullModel, Scenario, TowlineModel, WorldConfig};
 
 /// A plant parameter.
 pub type Parameter = registry::Parameter<PlantParams>;
+
+/// The towline model the parameter `model.towline` chooses; an elastic line's constants
+/// come from the scenario's `[elastic_towline]` section.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TowlineChoice {
+    /// The paper's ideal winch ([`TowlineModel::IdealWinch`]).
+    #[default]
+    IdealWinch,
+    /// An elastic line paid out by a winch ([`TowlineModel::Elastic`]).
+    Elastic,
+}
+
+impl TowlineChoice {
+    /// The FMI Enumeration type `TowlineModel` of `model.towline` (FMI 2.0 section
+    /// 2.2.3): 1 `ideal_winch`, 2 `elastic` (the scenario format's names, the codes
+    /// masters have always set).
+    pub const ENUMERATION: Enumeration = Enumeration {
+        name: "TowlineModel",
+        description: "How a towline transmits force",
+        items: &[
+            Item {
+                name: "ideal_winch",
+                value: 1,
+                description:
+                    "the commanded tension while the line is taut (Du et al. 2022, below eq. (3))",
+            },
+            Item {
+                name: "elastic",
+                value: 2,
+                description: "an elastic line paid out by a winch, its constants from the scenario",
+            },
+        ],
+    };
+
+    /// The value of its item of [`TowlineChoice::ENUMERATION`].
+    #[must_use]
+    pub const fn code(self) -> i32 {
+        match self {
+            TowlineChoice::IdealWinch => 1,
+            TowlineChoice::Elastic => 2,
+        }
+    }
+
+    /// The choice of an item's value; `None` for another value.
+    #[must_use]
+    pub const fn from_code(code: i32) -> Option<TowlineChoice> {
+        match code {
+            1 => Some(TowlineChoice::IdealWinch),
+            2 => Some(TowlineChoice::Elastic),
+            _ => None,
+        }
+    }
+}
 
 /// The plant's parameter values; the default takes the physics from the scenario.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,9 +82,8 @@ pub struct PlantParams {
     pub hull: HullModel,
     /// The towline model as the scenario says (`true`) or [`PlantParams::towline`].
     pub towline_from_scenario: bool,
-    /// The towline model when not from the scenario: 1 ideal winch, 2 elastic line
-    /// (its constants from the scenario).
-    pub towline: i32,
+    /// The towline model when not from the scenario.
+    pub towline: TowlineChoice,
     /// The integration step as the scenario says (`true`) or
     /// [`PlantParams::integration_step`].
     pub integration_step_from_scenario: bool,
@@ -43,7 +99,7 @@ impl Default for PlantParams {
             hull_from_scenario: true,
             hull: physics.hull_model,
             towline_from_scenario: true,
-            towline: 1,
+            towline: TowlineChoice::IdealWinch,
             integration_step_from_scenario: true,
             integration_step: physics.integration_step,
         }
@@ -60,24 +116,15 @@ impl PlantParams {
             config.hull_model = self.hull;
         }
         if !self.towline_from_scenario {
-            config.towline_model = if self.towline == 2 {
-                scenario.elastic_towline.into()
-            } else {
-                TowlineModel::IdealWinch
+            config.towline_model = match self.towline {
+                TowlineChoice::Elastic => scenario.elastic_towline.into(),
+                TowlineChoice::IdealWinch => TowlineModel::IdealWinch,
             };
         }
         if !self.integration_step_from_scenario {
             config.integration_step = self.integration_step;
         }
         config
-    }
-}
-
-/// The FMI code of a hull model (`model.hull`).
-fn hull_code(h: HullModel) -> i32 {
-    match h {
-        HullModel::LinearDamping => 1,
-        HullModel::NonlinearDamping => 2,
     }
 }
 
@@ -107,18 +154,12 @@ pub static PARAMETERS: &[Parameter] = &[
     Parameter {
         name: "model.hull",
         old_name: Some("hull_model"),
-        description: "Hull damping model when model.hull_from_scenario is false: 1 linear (constant D, the paper's eq. (1)), 2 nonlinear (Skjetne et al. 2004 for CyberShip II)",
-        kind: Kind::Integer {
-            min: 1,
-            max: 2,
-            get: |p| hull_code(p.hull),
-            set: |p, v| {
-                p.hull = if v == 1 {
-                    HullModel::LinearDamping
-                } else {
-                    HullModel::NonlinearDamping
-                };
-            },
+        description: "Hull damping model when model.hull_from_scenario is false: linear_damping (constant D, the paper's eq. (1)) or nonlinear_damping (Skjetne et al. 2004 for CyberShip II)",
+        kind: Kind::Enumeration {
+            enumeration: &HullModel::ENUMERATION,
+            get: |p| p.hull.code(),
+            // Only an item's value reaches the setter (`Parameter::set`).
+            set: |p, v| p.hull = HullModel::from_code(v).unwrap_or_default(),
         },
     },
     Parameter {
@@ -133,12 +174,12 @@ pub static PARAMETERS: &[Parameter] = &[
     Parameter {
         name: "model.towline",
         old_name: Some("towline_model"),
-        description: "Towline model when model.towline_from_scenario is false: 1 ideal winch holding the commanded tension while taut, 2 elastic line paid out by a winch (constants from the scenario)",
-        kind: Kind::Integer {
-            min: 1,
-            max: 2,
-            get: |p| p.towline,
-            set: |p, v| p.towline = v,
+        description: "Towline model when model.towline_from_scenario is false: ideal_winch holding the commanded tension while taut, or elastic, a line paid out by a winch (constants from the scenario)",
+        kind: Kind::Enumeration {
+            enumeration: &TowlineChoice::ENUMERATION,
+            get: |p| p.towline.code(),
+            // Only an item's value reaches the setter (`Parameter::set`).
+            set: |p, v| p.towline = TowlineChoice::from_code(v).unwrap_or_default(),
         },
     },
     Parameter {
@@ -192,5 +233,42 @@ mod tests {
             linear.world_config(&scenario).hull_model,
             HullModel::LinearDamping
         );
+    }
+
+    /// The choices keep the codes masters set before they were enumerations.
+    #[test]
+    fn choices_are_enumerations_with_the_codes_masters_use() {
+        let find = |name| registry::find(PARAMETERS, name).unwrap();
+        let mut p = PlantParams::default();
+        find("model.towline")
+            .set(&mut p, registry::Value::Integer(2))
+            .unwrap();
+        assert_eq!(p.towline, TowlineChoice::Elastic);
+        let e = find("model.towline")
+            .check(&registry::Value::Integer(0))
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "model.towline: must be one of 1 ideal_winch, 2 elastic, got 0"
+        );
+        find("model.hull")
+            .set(&mut p, registry::Value::Integer(1))
+            .unwrap();
+        assert_eq!(p.hull, HullModel::LinearDamping);
+        for item in TowlineChoice::ENUMERATION.items {
+            let choice = TowlineChoice::from_code(item.value).unwrap();
+            assert_eq!(choice.code(), item.value);
+        }
+        assert_eq!(TowlineChoice::from_code(3), None);
+        let scenario = Scenario::paper().unwrap();
+        let elastic = PlantParams {
+            towline_from_scenario: false,
+            towline: TowlineChoice::Elastic,
+            ..PlantParams::default()
+        };
+        assert!(matches!(
+            elastic.world_config(&scenario).towline_model,
+            TowlineModel::Elastic { .. }
+        ));
     }
 }

@@ -20,7 +20,7 @@ use std::sync::Arc;
 use towing_interface::codec::{
     obstacle_kind_code, ContractVariable, ObstacleField, TowlineField, Vessel,
 };
-use towing_interface::{LogHeader, RunSession, ScenarioFile};
+use towing_interface::{parameters, LogHeader, RunSession, ScenarioFile};
 use towing_log::topics::Log;
 use towing_model::registry::{Kind, Value};
 use towing_model::{ObstacleSlot, TowlineOutput, World, WorldInputs};
@@ -117,24 +117,12 @@ impl Plant {
         };
         let t = self.start_time;
         let guid = vars::DESCRIPTION.guid();
-        let mut parameters = serde_json::Map::new();
-        parameters.insert("scenario".into(), self.session.scenario_parameter().into());
-        parameters.insert("log_file".into(), self.session.log_file().into());
-        for p in PARAMETERS {
-            let value = match p.get(&self.params) {
-                Value::Real(v) => v.into(),
-                Value::Integer(v) => v.into(),
-                Value::Boolean(v) => v.into(),
-            };
-            parameters.insert(p.name.into(), value);
-        }
-        let parameters = serde_json::Value::Object(parameters);
         let header = LogHeader {
             unit: vars::MODEL_IDENTIFIER,
             guid: &guid,
             version: env!("CARGO_PKG_VERSION"),
             start_time: t,
-            parameters,
+            parameters: parameters::values_json(PARAMETERS, &self.params),
         };
         let inputs = &self.inputs;
         // Written before the log's own thread takes over.
@@ -232,6 +220,9 @@ impl Fmi2Model for Plant {
             PlantVariable::Contract(c) => real_output(self.world(), c).ok_or_else(|| {
                 vars::VARIABLES.unhandled(ValueType::Real, PlantVariable::Contract(c), "get")
             })?,
+            other @ PlantVariable::Session(_) => {
+                return Err(vars::VARIABLES.unhandled(ValueType::Real, other, "get"))
+            }
         })
     }
 
@@ -304,28 +295,21 @@ impl Fmi2Model for Plant {
 
     fn get_string(&self, vr: u32) -> Result<String, String> {
         match vars::VARIABLES.decode(ValueType::String, vr)? {
-            PlantVariable::Contract(ContractVariable::Scenario) => {
-                Ok(self.session.scenario_parameter().to_owned())
-            }
-            PlantVariable::Contract(ContractVariable::LogFile) => {
-                Ok(self.session.log_file().to_owned())
-            }
+            PlantVariable::Session(i) => Ok(self.session.parameter(i)),
             other => Err(vars::VARIABLES.unhandled(ValueType::String, other, "get")),
         }
     }
 
+    /// A session parameter; a new `scenario` during initialization rebuilds the world (and
+    /// is undone when that fails).
     fn set_string(&mut self, log: &Logger, vr: u32, value: &str) -> Result<(), String> {
         match vars::VARIABLES.decode(ValueType::String, vr)? {
-            PlantVariable::Contract(ContractVariable::Scenario) => {
-                let previous = self.session.replace_scenario_parameter(value);
-                self.reload_if_initializing(log).inspect_err(|_| {
+            PlantVariable::Session(i) => match self.session.set_parameter(i, value)? {
+                Some(previous) => self.reload_if_initializing(log).inspect_err(|_| {
                     self.session.replace_scenario_parameter(&previous);
-                })
-            }
-            PlantVariable::Contract(ContractVariable::LogFile) => {
-                self.session.set_log_file(value);
-                Ok(())
-            }
+                }),
+                None => Ok(()),
+            },
             _ => Err(format!("value reference {vr} is not a settable String")),
         }
     }
@@ -380,6 +364,7 @@ impl Fmi2Model for Plant {
                 Value::Real(v) => out.extend_from_slice(&v.to_le_bytes()),
                 Value::Integer(v) => out.extend_from_slice(&v.to_le_bytes()),
                 Value::Boolean(v) => out.push(u8::from(v)),
+                Value::String(v) => put_str(out, &v),
             }
         }
         for tau in &self.inputs.tug_tau {
@@ -420,8 +405,11 @@ impl Fmi2Model for Plant {
         for p in PARAMETERS {
             let value = match p.kind {
                 Kind::Real { .. } => Value::Real(f64::from_le_bytes(r.array()?)),
-                Kind::Integer { .. } => Value::Integer(i32::from_le_bytes(r.array()?)),
+                Kind::Integer { .. } | Kind::Enumeration { .. } => {
+                    Value::Integer(i32::from_le_bytes(r.array()?))
+                }
                 Kind::Boolean { .. } => Value::Boolean(r.take(1)?[0] != 0),
+                Kind::String { .. } => Value::String(r.string()?),
             };
             p.check(&value)
                 .map_err(|e| format!("TowingPlant state: parameter `{}`: {}", e.field, e.reason))?;

@@ -6,10 +6,11 @@
 //!
 //! The connected variables (vessel states, towline values and obstacle slots as outputs, the
 //! commands as inputs) and their value references, units and declared types are those of
-//! the interface contract, `towing-interface` (with the String parameters `scenario` and
-//! `log_file`); this module adds the plant's own parameters (the registry of
-//! [`crate::params`], value references `10 + index`) and
-//! the Boolean outputs `towlineN.slack` (the contract's [`TowlineField::Slack`]).
+//! the interface contract, `towing-interface`; the parameters are the session's (the String
+//! parameters `scenario`, `log_file`, `run_id` of [`towing_interface::session::PARAMETERS`],
+//! value references 1, 2, 3) and the plant's own (the registry of [`crate::params`], value
+//! references `10 + index`); the plant adds the Boolean outputs `towlineN.slack` (the
+//! contract's [`TowlineField::Slack`]).
 //!
 //! The plant's getters and setters decode every value reference through [`VARIABLES`]
 //! into a [`PlantVariable`] and match on it.
@@ -20,30 +21,22 @@ use std::sync::LazyLock;
 use towing_interface::codec::{
     ContractVariable, ModelVariable, Towline, TowlineField, VariableTable,
 };
-use towing_interface::types::real_kind;
-use towing_interface::variables::{self as shared, parameter, Direction};
-use towing_interface::ModelInfo;
-use towing_model::registry::Kind;
+use towing_interface::variables::{self as shared, Direction};
+use towing_interface::{parameters, session, vr, ModelInfo};
 
-use crate::params::{PlantParams, PARAMETERS};
+use crate::params::PARAMETERS;
 
 pub use towing_interface::vr::{
-    obstacle, tension_cmd, towline, tug_force, vessel_state, LOG_FILE, OBSTACLE_KIND, SCENARIO,
+    obstacle, tension_cmd, towline, tug_force, vessel_state, LOG_FILE, OBSTACLE_KIND, RUN_ID,
+    SCENARIO,
 };
 
-/// Value reference of the registry's parameter `index` ([`PARAMETERS`]).
-#[must_use]
-pub const fn parameter_vr(index: usize) -> u32 {
-    10 + index as u32
-}
+pub use towing_interface::parameters::parameter_vr;
 
 /// Value reference of the plant parameter `name`.
 #[must_use]
 pub fn parameter_vr_of(name: &str) -> Option<u32> {
-    PARAMETERS
-        .iter()
-        .position(|p| p.name == name)
-        .map(parameter_vr)
+    parameters::parameter_vr_of(PARAMETERS, name)
 }
 
 /// A variable of the plant, as its getters and setters see it.
@@ -52,6 +45,8 @@ pub enum PlantVariable {
     /// A variable of the interface contract: the plant declares every one (the commands as
     /// inputs, the rest as outputs, `towlineN.slack` its own).
     Contract(ContractVariable),
+    /// A parameter of the session: its index in [`session::PARAMETERS`].
+    Session(usize),
     /// A parameter: its index in the registry ([`PARAMETERS`]).
     Parameter(usize),
 }
@@ -60,6 +55,7 @@ impl ModelVariable for PlantVariable {
     fn value_reference(self) -> u32 {
         match self {
             PlantVariable::Contract(c) => c.encode(),
+            PlantVariable::Session(i) => vr::session_parameter(i),
             PlantVariable::Parameter(i) => parameter_vr(i),
         }
     }
@@ -67,11 +63,8 @@ impl ModelVariable for PlantVariable {
     fn value_type(self) -> ValueType {
         match self {
             PlantVariable::Contract(c) => c.value_type(),
-            PlantVariable::Parameter(i) => match PARAMETERS[i].kind {
-                Kind::Real { .. } => ValueType::Real,
-                Kind::Integer { .. } => ValueType::Integer,
-                Kind::Boolean { .. } => ValueType::Boolean,
-            },
+            PlantVariable::Session(i) => parameters::value_type(&session::PARAMETERS[i]),
+            PlantVariable::Parameter(i) => parameters::value_type(&PARAMETERS[i]),
         }
     }
 
@@ -85,11 +78,13 @@ impl ModelVariable for PlantVariable {
 
 /// The plant's variables by value reference, built once.
 pub static VARIABLES: LazyLock<VariableTable<PlantVariable>> = LazyLock::new(|| {
+    let session = (0..session::PARAMETERS.len()).map(PlantVariable::Session);
     let own = (0..PARAMETERS.len()).map(PlantVariable::Parameter);
     VariableTable::new(
         MODEL_IDENTIFIER,
         ContractVariable::all()
             .map(PlantVariable::Contract)
+            .chain(session)
             .chain(own),
     )
 });
@@ -112,49 +107,8 @@ pub const MODEL_IDENTIFIER: &str = "TowingPlant";
 /// The plant's model description, built once.
 pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(build);
 
-/// The model-description variable of the registry's parameter `index`.
-fn parameter_variable(index: usize) -> fmi2_slave::description::Variable {
-    let p = &PARAMETERS[index];
-    let defaults = PlantParams::default();
-    let kind = match p.kind {
-        Kind::Real {
-            unit,
-            min,
-            max,
-            get,
-            ..
-        } => {
-            let mut kind = real_kind(unit, Some(get(&defaults)));
-            if let VariableKind::Real {
-                min: lo, max: hi, ..
-            } = &mut kind
-            {
-                *lo = min.value();
-                *hi = max.value();
-            }
-            kind
-        }
-        Kind::Integer { min, max, get, .. } => VariableKind::Integer {
-            declared_type: None,
-            start: Some(get(&defaults)),
-            min: Some(min),
-            max: Some(max),
-        },
-        Kind::Boolean { get, .. } => VariableKind::Boolean {
-            start: Some(get(&defaults)),
-        },
-    };
-    parameter(p.name, parameter_vr(index), kind, p.description)
-}
-
 fn build() -> ModelDescription {
-    let mut v = vec![
-        shared::scenario_parameter(
-            "Path of the scenario file (TOML, docs/scenario-format.md); empty: the bundled paper scenario resources/paper.toml",
-        ),
-        shared::log_file_parameter(),
-    ];
-    v.extend((0..PARAMETERS.len()).map(parameter_variable));
+    let mut v = parameters::variables(&INFO, PARAMETERS);
     v.extend(shared::commands(Direction::Input));
     v.extend(shared::vessel_states(Direction::Output));
     for line in Towline::ALL {
@@ -170,5 +124,5 @@ fn build() -> ModelDescription {
         ));
     }
     v.extend(shared::obstacles(Direction::Output));
-    INFO.model_description(v)
+    INFO.model_description(v, &parameters::enumerations(PARAMETERS))
 }

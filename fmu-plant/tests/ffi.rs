@@ -74,6 +74,11 @@ fn without_resources_and_scenario_initialization_is_refused_with_a_reason() {
 }
 
 #[test]
+fn run_id_is_kept_and_a_control_character_refused() {
+    testing::assert_run_id_is_kept_and_checked(exports(), &DESCRIPTION);
+}
+
+#[test]
 fn wrong_guid_gives_null_and_says_why() {
     let log = Fmu::try_new_with_guid(exports(), "{not-the-guid}", "g", None, false).unwrap_err();
     let text: String = log.iter().map(|m| m.text.clone()).collect();
@@ -158,7 +163,43 @@ fn bad_parameters_are_refused_naming_the_parameter() {
     testing::assert_last_message_contains(&fmu, "model.integration_step");
     let fmu = plant("params3");
     assert_eq!(fmu.set_integer(vr("model.towline"), -1), Fmi2Status::Error);
-    testing::assert_last_message_contains(&fmu, "model.towline");
+    testing::assert_last_message_contains(
+        &fmu,
+        "parameter `model.towline`: must be one of 1 ideal_winch, 2 elastic, got -1",
+    );
+}
+
+/// The Enumeration parameters are set and read with fmi2SetInteger/fmi2GetInteger by
+/// their items' values (FMI 2.0 section 2.1.7), and the choice reaches the world: the
+/// ideal winch's tension is the command, an elastic line's follows its stretch.
+#[test]
+fn enumeration_parameters_choose_by_item_value() {
+    let vr = |name| vars::parameter_vr_of(name).unwrap();
+    let tension = |towline: i32| {
+        let fmu = plant("enum");
+        let from_scenario = vr("model.towline_from_scenario");
+        assert_eq!(fmu.set_boolean(from_scenario, false), Fmi2Status::Ok);
+        assert_eq!(
+            fmu.set_integer(vr("model.towline"), towline),
+            Fmi2Status::Ok
+        );
+        assert_eq!(fmu.set_integer(vr("model.hull"), 1), Fmi2Status::Ok);
+        fmu.init(0.0, None);
+        assert_eq!(fmu.get_integer(vr("model.towline")), towline);
+        assert_eq!(fmu.get_integer(vr("model.hull")), 1);
+        assert_eq!(fmu.set_real(vars::tension_cmd(0), 2.0), Fmi2Status::Ok);
+        for k in 0..10 {
+            assert_eq!(fmu.step(f64::from(k) * 0.1, 0.1), Fmi2Status::Ok);
+        }
+        fmu.get_real(vars::towline(0, 2))
+    };
+    let ideal = tension(1);
+    let elastic = tension(2);
+    assert!((ideal - 2.0).abs() < 1e-9, "ideal winch: {ideal}");
+    assert!(
+        (elastic - ideal).abs() > 1e-3,
+        "elastic {elastic} vs ideal {ideal}"
+    );
 }
 
 /// The paper scenario with one replacement applied (the original text must be present).

@@ -42,8 +42,13 @@ fn a_run_logs_every_topic_once_at_the_start_and_after_each_step() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("plant.mcap");
     let fmu = plant_logging_to("log", &path);
+    assert_eq!(
+        fmu.set_string(vars::RUN_ID, "run-7 of the test"),
+        Fmi2Status::Ok
+    );
     fmu.init(0.0, None);
     assert_eq!(fmu.get_string(vars::LOG_FILE), path.to_str().unwrap());
+    assert_eq!(fmu.get_string(vars::RUN_ID), "run-7 of the test");
     pull(&fmu);
     let n = 50;
     steps(&fmu, 0.0, n);
@@ -128,9 +133,16 @@ fn a_run_logs_every_topic_once_at_the_start_and_after_each_step() {
     assert_eq!(run.metadata["scenario"], topics::BUNDLED_SCENARIO_LABEL);
     assert_eq!(run.metadata["scenario_name"], "paper");
     assert_eq!(run.metadata["start_time"], "0");
+    assert_eq!(run.metadata["run_id"], "run-7 of the test");
     let params: serde_json::Value = serde_json::from_str(&run.metadata["parameters"]).unwrap();
     assert_eq!(params["log_file"], path.to_str().unwrap());
+    assert_eq!(params["run_id"], "run-7 of the test");
+    assert_eq!(params["scenario"], "");
     assert_eq!(params["model.hull_from_scenario"], true);
+    assert_eq!(
+        params["model.hull"], 2,
+        "an Enumeration as its item's value"
+    );
     assert_eq!(params["log.scene_interval"], 0.5);
     let att = mcap::read::attachment(&bytes, &summary.attachment_indexes[0]).unwrap();
     assert_eq!(att.name, "scenario.toml");

@@ -222,6 +222,7 @@ def write(tmp_path, text):
     ("keep_logs = 1\n", "'keep_logs' must be true or false"),
     ("[parameters]\narchitecture = 1\n", "[parameters] architecture: must be a non-empty list"),
     ("[parameters]\nscenario = [\"x\"]\n", "[parameters] scenario: set by the campaign itself"),
+    ("[parameters]\n\"plant.run_id\" = [\"x\"]\n", "[parameters] plant.run_id: set by the campaign itself"),
     ("[thresholds]\ndrift_max_deg = \"big\"\n", "[thresholds]: 'drift_max_deg' must be a finite number"),
     ("[random]\nseed = 1\n", "[random] 'count' must be an integer >= 1"),
 ])
@@ -236,10 +237,14 @@ def test_parameters_and_globs_are_checked_before_anything_runs(tmp_path, fmus):
     with pytest.raises(campaign.CampaignError, match="the controller FMU has no parameter 'nonsense'"):
         campaign.check_parameters(c, fmus["TowingPlant"], fmus["TowingController"])
     c = campaign.load_campaign(write(tmp_path, "[parameters]\narchitecture = [1.5]\n"))
-    with pytest.raises(campaign.CampaignError, match="controller parameter 'architecture' is Integer, got 1.5"):
+    with pytest.raises(campaign.CampaignError, match="controller parameter 'architecture' is Enumeration, got 1.5"):
         campaign.check_parameters(c, fmus["TowingPlant"], fmus["TowingController"])
     c = campaign.load_campaign(write(tmp_path, "[parameters]\narchitecture = [1, 3]\n"))
-    with pytest.raises(campaign.CampaignError, match=r"controller parameter 'architecture' must be in \[1, 2\] .*, got 3"):
+    with pytest.raises(campaign.CampaignError,
+                       match=r"controller parameter 'architecture' must be one of 1 distributed, 2 centralized \(its modelDescription\), got 3"):
+        campaign.check_parameters(c, fmus["TowingPlant"], fmus["TowingController"])
+    c = campaign.load_campaign(write(tmp_path, "[parameters]\n\"admm.max_iterations\" = [0]\n"))
+    with pytest.raises(campaign.CampaignError, match=r"controller parameter 'admm.max_iterations' must be in \[1, 100\] .*, got 0"):
         campaign.check_parameters(c, fmus["TowingPlant"], fmus["TowingController"])
     c = campaign.load_campaign(write(tmp_path, "[parameters]\n\"plant.model.hull\" = [1, 2]\narchitecture = [1, 2]\n"))
     campaign.check_parameters(c, fmus["TowingPlant"], fmus["TowingController"])

@@ -19,6 +19,7 @@
 
 import json
 import math
+import re
 import subprocess
 import sys
 from types import SimpleNamespace
@@ -293,7 +294,8 @@ def test_master_with_the_plant_and_a_stand_in_controller(plant_fmu, tmp_path, mo
     plant_md = fmpy.read_model_description(plant_fmu)
     variables = [var(v.name, "input", v.type, v.valueReference) for v in plant_md.modelVariables if v.causality == "output"]
     variables += [var(name, "output", t, 5000 + i, start=value) for i, (name, (t, value)) in enumerate(STAND_IN_OUTPUTS.items())]
-    variables += [var("scenario", "parameter", "String", 1, ""), var("avoidance_scheme", "parameter", "Integer", 2, 1)]
+    variables += [var("scenario", "parameter", "String", 1, ""), var("avoidance_scheme", "parameter", "Enumeration", 2, 1),
+                  var("run_id", "parameter", "String", 3, "")]
     md = SimpleNamespace(guid="{stand-in}", coSimulation=SimpleNamespace(modelIdentifier="StandIn"), modelVariables=variables)
     fake_fmu = tmp_path / "StandIn.fmu"
     fake_fmu.write_bytes(b"")
@@ -312,11 +314,12 @@ def test_master_with_the_plant_and_a_stand_in_controller(plant_fmu, tmp_path, mo
     monkeypatch.setattr(closed_loop, "FMU2Slave", make_slave)
     out = tmp_path / "out"
     code = closed_loop.main(["--plant", plant_fmu, "--controller", str(fake_fmu), "--stop-time", "30", "--scheme", "2",
-                             "--map-size", "640x480", "--out", str(out), "--quiet"])
+                             "--map-size", "640x480", "--out", str(out), "--quiet", "--run-id", "stand-in run"])
     assert code == 0
     slave = slaves[0]
     assert slave.freed
     assert slave.values[2] == 2  # --scheme set avoidance_scheme
+    assert slave.values[3] == "stand-in run"  # --run-id set run_id
     assert len(slave.steps) == 300 and slave.steps[0] == (0.0, pytest.approx(0.1))
     header, d = read_csv(out / "timeseries.csv")
     plant_outputs = [v.name for v in plant_md.modelVariables if v.causality == "output"]
@@ -333,7 +336,23 @@ def test_master_with_the_plant_and_a_stand_in_controller(plant_fmu, tmp_path, mo
     assert summary["controller_samples"] == 30
     assert summary["admm_iterations"] == {"median": 7.0, "p99": 7.0, "max": 7.0}
     assert summary["final_ship_pose"]["x"] == d["ship.x"][-1]
+    assert summary["run_id"] == "stand-in run"
     assert_map(out / "map.png", (640, 480))
+
+
+def test_an_enumeration_parameter_takes_its_value_or_an_items_name():
+    items = [SimpleNamespace(name="distributed", value="1"), SimpleNamespace(name="centralized", value="2")]
+    v = SimpleNamespace(name="architecture", declaredType=SimpleNamespace(items=items))
+    assert closed_loop.enumeration_value(v, "2") == 2
+    assert closed_loop.enumeration_value(v, "centralized") == 2
+    with pytest.raises(ValueError, match="'central' is neither a number nor an item name \\(1 distributed, 2 centralized\\)"):
+        closed_loop.enumeration_value(v, "central")
+
+
+def test_generated_run_ids_differ_and_name_the_time():
+    a, b = closed_loop.new_run_id(), closed_loop.new_run_id()
+    assert a != b
+    assert re.fullmatch(r"\d{8}T\d{6}Z-[0-9a-f]{8}", a), a
 
 
 def test_master_refuses_fmus_that_do_not_connect(plant_fmu, tmp_path):
@@ -347,7 +366,7 @@ def test_master_refuses_fmus_that_do_not_connect(plant_fmu, tmp_path):
 def test_master_help_documents_the_options():
     r = subprocess.run([sys.executable, str(MASTER), "--help"], capture_output=True, text=True, check=True)
     for option in ("--plant", "--controller", "--scenario", "--stop-time", "--step", "--architecture", "--scheme", "--param",
-                   "--out", "--quiet"):
+                   "--run-id", "--out", "--quiet"):
         assert option in r.stdout
 
 

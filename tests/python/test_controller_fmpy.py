@@ -55,12 +55,35 @@ def test_nan_input_is_refused_naming_the_variable(controller_fmu, tmp_path):
     fmu.freeInstance()
 
 
-def test_bad_architecture_is_refused_at_initialization(controller_fmu, tmp_path):
+def test_bad_architecture_is_refused_naming_the_items(controller_fmu, tmp_path):
     fmu, vr, log = instantiate(controller_fmu, tmp_path, "arch")
     fmu.setupExperiment(startTime=0.0)
-    fmu.setInteger([vr["architecture"]], [3])
-    fmu.enterInitializationMode()
     with pytest.raises(FMICallException):
-        fmu.exitInitializationMode()
-    assert "architecture" in log.text(), log.text()
+        fmu.setInteger([vr["architecture"]], [3])
+    assert "parameter `architecture`: must be one of 1 distributed, 2 centralized, got 3" in log.text(), log.text()
+    fmu.freeInstance()
+
+
+def test_enumerations_and_run_id_in_the_model_description(controller_fmu, tmp_path):
+    md = fmpy.read_model_description(controller_fmu)
+    names = {v.name: v for v in md.modelVariables}
+    for name, type_name, items in (("architecture", "Architecture", ["distributed", "centralized"]),
+                                   ("avoidance_scheme", "AvoidanceScheme", ["alter_and_cost", "alter_only", "cost_only"]),
+                                   ("mpc.hull_model", "HullModel", ["linear_damping", "nonlinear_damping"])):
+        v = names[name]
+        assert v.type == "Enumeration" and v.declaredType.name == type_name, name
+        assert [i.name for i in v.declaredType.items] == items
+        assert [int(i.value) for i in v.declaredType.items] == list(range(1, len(items) + 1))
+    run_id = names["run_id"]
+    assert (run_id.type, run_id.valueReference, run_id.causality) == ("String", 3, "parameter")
+    # Set and read through fmi2SetInteger/fmi2GetInteger and fmi2SetString/fmi2GetString.
+    fmu, vr, log = instantiate(controller_fmu, tmp_path, "enum")
+    fmu.setupExperiment(startTime=0.0)
+    fmu.setInteger([vr["architecture"]], [2])
+    fmu.setString([vr["run_id"]], ["fmpy run"])
+    fmu.enterInitializationMode()
+    assert fmu.getInteger([vr["architecture"]]) == [2]
+    assert fmu.getString([vr["run_id"]]) == [b"fmpy run"]
+    fmu.exitInitializationMode()
+    fmu.terminate()
     fmu.freeInstance()

@@ -6,12 +6,14 @@
   the start; controller: one per control sample);
 - every message validates against its channel's JSON schema (jsonschema);
 - log times never decrease within a file, and equal the `t` the messages carry;
-- the `run` metadata and the `scenario.toml` attachment are there;
+- the `run` metadata and the `scenario.toml` attachment are there, and both logs carry the
+  run id the master generated (`run_id`);
 - a truncated copy of a log still yields its first messages with NonSeekingReader
   (log_time_order=False), and a cut never raises anything but a Python exception.
 """
 
 import json
+import re
 import subprocess
 import sys
 
@@ -190,6 +192,11 @@ def test_run_metadata_and_scenario_attachment(logged_run, name, unit):
     assert run["guid"].startswith("{") and run["version"]
     params = json.loads(run["parameters"])
     assert params["log_file"] == str((logs / name).resolve())
+    # The master gave both FMUs the same generated run id.
+    assert run["run_id"] == params["run_id"] == logged_run[1]["run_id"]
+    assert re.fullmatch(r"\d{8}T\d{6}Z-[0-9a-f]{8}", run["run_id"]), run["run_id"]
+    choice = "architecture" if unit == "TowingController" else "model.hull"
+    assert isinstance(params[choice], int), "an Enumeration is logged as its item's value"
     assert [(a.name, a.media_type) for a in attachments] == [("scenario.toml", "application/toml")]
     assert attachments[0].data.decode() == (ROOT / "scenarios" / "paper.toml").read_text()
 

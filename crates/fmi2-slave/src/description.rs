@@ -13,9 +13,11 @@
 //! * element order `CoSimulation`, `UnitDefinitions`, `TypeDefinitions`, `LogCategories`,
 //!   `DefaultExperiment`, `ModelVariables`, `ModelStructure` (empty
 //!   `UnitDefinitions`/`TypeDefinitions`/`LogCategories` omitted, no `VendorAnnotations`);
-//! * a variable's `declaredType` names a `SimpleType` of the same base type whose units are
+//! * a variable's `declaredType` names a `SimpleType` of the same kind whose units are
 //!   declared; the variable still writes its own `unit`/`displayUnit` (which must agree
-//!   with the type's);
+//!   with the type's); an `Enumeration` variable names an Enumeration type (its
+//!   `declaredType` is required) and starts at one of its items' values (sections 2.2.3,
+//!   2.2.7);
 //! * `causality` and `variability` always written; `initial` written explicitly (the
 //!   effective value) for every variable except inputs and the independent variable, which
 //!   must not carry it;
@@ -165,7 +167,9 @@ pub struct SimpleType {
     pub kind: SimpleTypeKind,
 }
 
-/// The child element of a [`SimpleType`]. Only Real and Integer types are supported.
+/// The child element of a [`SimpleType`]: Real, Integer and Enumeration types are
+/// supported (FMI 2.0 section 2.2.3; Boolean and String types carry no attribute worth
+/// declaring).
 #[derive(Debug, Clone, PartialEq)]
 pub enum SimpleTypeKind {
     /// `<Real>`.
@@ -190,14 +194,68 @@ pub enum SimpleTypeKind {
         /// Upper bound.
         max: Option<i32>,
     },
+    /// `<Enumeration>` with its `<Item>`s (FMI 2.0 section 2.2.3): the values a variable of
+    /// this type may take, each with a name. Variables of the type are
+    /// [`VariableKind::Enumeration`], read and written with `fmi2GetInteger` and
+    /// `fmi2SetInteger` (section 2.1.7).
+    Enumeration {
+        /// `quantity` (free text).
+        quantity: Option<String>,
+        /// The items, at least one; names and values unique within the type.
+        items: Vec<EnumerationItem>,
+    },
+}
+
+/// `SimpleType/Enumeration/Item` (FMI 2.0 section 2.2.3): one value of an enumeration.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct EnumerationItem {
+    /// `name`, unique within the enumeration.
+    pub name: String,
+    /// `value`, unique within the enumeration (FMI 2.0 requires it; FMI 1.0 numbered the
+    /// items 1..n implicitly, which the values here usually follow).
+    pub value: i32,
+    /// `description` (omitted when empty).
+    pub description: String,
+}
+
+impl EnumerationItem {
+    /// An item.
+    pub fn new(name: &str, value: i32, description: &str) -> Self {
+        EnumerationItem {
+            name: name.to_string(),
+            value,
+            description: description.to_string(),
+        }
+    }
+}
+
+/// `1 distributed, 2 centralized`: the items' values and names, for messages.
+pub fn items_text(items: &[EnumerationItem]) -> String {
+    items
+        .iter()
+        .map(|i| format!("{} {}", i.value, i.name))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 impl SimpleTypeKind {
-    /// The base type.
+    /// The base type through which variables of this type are accessed (an Enumeration's
+    /// is Integer: FMI 2.0 section 2.1.7).
     pub fn value_type(&self) -> ValueType {
         match self {
             SimpleTypeKind::Real { .. } => ValueType::Real,
-            SimpleTypeKind::Integer { .. } => ValueType::Integer,
+            SimpleTypeKind::Integer { .. } | SimpleTypeKind::Enumeration { .. } => {
+                ValueType::Integer
+            }
+        }
+    }
+
+    /// The XML element: `Real`, `Integer` or `Enumeration`.
+    pub fn element(&self) -> &'static str {
+        match self {
+            SimpleTypeKind::Real { .. } => "Real",
+            SimpleTypeKind::Integer { .. } => "Integer",
+            SimpleTypeKind::Enumeration { .. } => "Enumeration",
         }
     }
 }
@@ -231,6 +289,26 @@ impl SimpleType {
         }
     }
 
+    /// An Enumeration type (FMI 2.0 section 2.2.3); `quantity` takes `""` for "none".
+    pub fn enumeration(name: &str, quantity: &str, items: Vec<EnumerationItem>) -> Self {
+        SimpleType {
+            name: name.to_string(),
+            description: String::new(),
+            kind: SimpleTypeKind::Enumeration {
+                quantity: opt_unit(quantity),
+                items,
+            },
+        }
+    }
+
+    /// The items of an Enumeration type (none for other types).
+    pub fn items(&self) -> &[EnumerationItem] {
+        match &self.kind {
+            SimpleTypeKind::Enumeration { items, .. } => items,
+            _ => &[],
+        }
+    }
+
     /// Sets `description`.
     pub fn with_description(mut self, description: &str) -> Self {
         self.description = description.to_string();
@@ -246,9 +324,7 @@ impl SimpleType {
             SimpleTypeKind::Real {
                 display_unit: d, ..
             } => *d = Some(display_unit.to_string()),
-            SimpleTypeKind::Integer { .. } => {
-                panic!("with_display_unit on non-Real type '{}'", self.name)
-            }
+            _ => panic!("with_display_unit on non-Real type '{}'", self.name),
         }
         self
     }
@@ -265,9 +341,7 @@ impl SimpleType {
                 *lo = Some(min);
                 *hi = Some(max);
             }
-            SimpleTypeKind::Integer { .. } => {
-                panic!("with_real_range on non-Real type '{}'", self.name)
-            }
+            _ => panic!("with_real_range on non-Real type '{}'", self.name),
         }
         self
     }
@@ -284,9 +358,7 @@ impl SimpleType {
                 *lo = Some(min);
                 *hi = Some(max);
             }
-            SimpleTypeKind::Real { .. } => {
-                panic!("with_integer_range on non-Integer type '{}'", self.name)
-            }
+            _ => panic!("with_integer_range on non-Integer type '{}'", self.name),
         }
         self
     }
@@ -488,24 +560,44 @@ pub enum VariableKind {
         /// Start value.
         start: Option<String>,
     },
+    /// `<Enumeration>` (FMI 2.0 section 2.2.7): a value among the items of its declared
+    /// type, accessed with `fmi2GetInteger`/`fmi2SetInteger` (section 2.1.7); its value
+    /// reference shares the Integer numbering ("Integer/Enumeration", section 2.2.7).
+    Enumeration {
+        /// `declaredType` (required): must name an Enumeration [`SimpleType`].
+        declared_type: String,
+        /// Start value: the value of one of the type's items.
+        start: Option<i32>,
+    },
 }
 
 impl VariableKind {
-    /// The base type.
+    /// The base type through which the variable is accessed (an Enumeration's is Integer:
+    /// FMI 2.0 section 2.1.7).
     pub fn value_type(&self) -> ValueType {
         match self {
             VariableKind::Real { .. } => ValueType::Real,
-            VariableKind::Integer { .. } => ValueType::Integer,
+            VariableKind::Integer { .. } | VariableKind::Enumeration { .. } => ValueType::Integer,
             VariableKind::Boolean { .. } => ValueType::Boolean,
             VariableKind::String { .. } => ValueType::String,
         }
     }
 
-    /// The `declaredType` (Real and Integer only).
+    /// The XML element: `Real`, `Integer`, `Boolean`, `String` or `Enumeration`.
+    pub fn element(&self) -> &'static str {
+        match self {
+            VariableKind::Enumeration { .. } => "Enumeration",
+            other => other.value_type().as_str(),
+        }
+    }
+
+    /// The `declaredType` (Real, Integer and Enumeration only; an Enumeration always has
+    /// one).
     pub fn declared_type(&self) -> Option<&str> {
         match self {
             VariableKind::Real { declared_type, .. }
             | VariableKind::Integer { declared_type, .. } => declared_type.as_deref(),
+            VariableKind::Enumeration { declared_type, .. } => Some(declared_type),
             VariableKind::Boolean { .. } | VariableKind::String { .. } => None,
         }
     }
@@ -514,7 +606,9 @@ impl VariableKind {
     pub fn has_start(&self) -> bool {
         match self {
             VariableKind::Real { start, .. } => start.is_some(),
-            VariableKind::Integer { start, .. } => start.is_some(),
+            VariableKind::Integer { start, .. } | VariableKind::Enumeration { start, .. } => {
+                start.is_some()
+            }
             VariableKind::Boolean { start } => start.is_some(),
             VariableKind::String { start } => start.is_some(),
         }
@@ -536,6 +630,7 @@ impl VariableKind {
 /// | [`integer_output`](Self::integer_output), [`boolean_output`](Self::boolean_output) | output | discrete | calculated | none | outputs `""`, initial omitted |
 /// | [`integer_parameter`](Self::integer_parameter), [`boolean_parameter`](Self::boolean_parameter) | parameter | given | exact | given | |
 /// | [`string_parameter`](Self::string_parameter) | parameter | fixed | exact | given | |
+/// | [`enumeration_parameter`](Self::enumeration_parameter) | parameter | given | exact | given | |
 ///
 /// `unit` arguments take `""` for "no unit". Refine with the builder methods
 /// ([`initial_depends_on`](Self::initial_depends_on),
@@ -788,6 +883,30 @@ impl Variable {
         )
     }
 
+    /// An Enumeration parameter (`initial="exact"`) of the Enumeration type
+    /// `declared_type`, starting at the item of value `start` (FMI 2.0 section 2.2.7).
+    pub fn enumeration_parameter(
+        name: &str,
+        vr: u32,
+        declared_type: &str,
+        start: i32,
+        variability: Variability,
+        description: &str,
+    ) -> Self {
+        Self::base(
+            name,
+            vr,
+            description,
+            Causality::Parameter,
+            variability,
+            Some(Initial::Exact),
+            VariableKind::Enumeration {
+                declared_type: declared_type.to_string(),
+                start: Some(start),
+            },
+        )
+    }
+
     /// A fixed String parameter (`initial="exact"`); use
     /// [`with_variability`](Self::with_variability) for a tunable one.
     pub fn string_parameter(name: &str, vr: u32, start: &str, description: &str) -> Self {
@@ -838,17 +957,18 @@ impl Variable {
         self
     }
 
-    /// Sets `declaredType` (the name of a [`SimpleType`] of the same base type).
+    /// Sets `declaredType` (the name of a [`SimpleType`] of the same kind).
     ///
     /// # Panics
-    /// If the variable is neither Real nor Integer (a programming error in the variable
-    /// table).
+    /// If the variable is neither Real, Integer nor Enumeration (a programming error in the
+    /// variable table).
     pub fn with_declared_type(mut self, name: &str) -> Self {
         match &mut self.kind {
             VariableKind::Real { declared_type, .. }
             | VariableKind::Integer { declared_type, .. } => {
                 *declared_type = Some(name.to_string());
             }
+            VariableKind::Enumeration { declared_type, .. } => name.clone_into(declared_type),
             VariableKind::Boolean { .. } | VariableKind::String { .. } => panic!(
                 "with_declared_type on non-Real/Integer variable '{}'",
                 self.name
@@ -1012,8 +1132,12 @@ impl ModelDescription {
     /// (exact/approx/input) and absent when calculated or independent, finite numbers with
     /// `min <= start <= max`, declared unit and display unit, at most one independent
     /// variable; type definitions (unique non-empty names, declared units and display units,
-    /// finite `min <= max`); a variable's `declaredType` names an existing type of the same
-    /// base type, and a unit given by both the variable and its type agrees; dependencies only on outputs/initial unknowns, referring to exactly one
+    /// finite `min <= max`; an Enumeration's items: at least one, names and values unique);
+    /// a variable's `declaredType` names an existing type of the same kind (an Enumeration
+    /// variable an Enumeration type), a unit given by both the variable and its type
+    /// agrees, and an Enumeration's start is the value of one of its type's items
+    /// (FMI 2.0 sections 2.2.3, 2.2.7); dependencies only on outputs/initial unknowns,
+    /// referring to exactly one
     /// existing eligible variable (inputs for outputs; inputs and parameters for initial
     /// unknowns; the independent variable for both), without duplicates.
     ///
@@ -1142,7 +1266,7 @@ impl ModelDescription {
             if n.is_empty() {
                 errors.push(format!(
                     "type definition with empty name ({} type)",
-                    t.value_type().as_str()
+                    t.kind.element()
                 ));
             } else if !names.insert(n) {
                 errors.push(format!("type '{n}' is declared twice"));
@@ -1185,6 +1309,12 @@ impl ModelDescription {
                         check_text(errors, &format!("quantity of {who}"), q);
                     }
                     check_range(errors, &who, None, *min, *max);
+                }
+                SimpleTypeKind::Enumeration { quantity, items } => {
+                    if let Some(q) = quantity {
+                        check_text(errors, &format!("quantity of {who}"), q);
+                    }
+                    check_items(errors, &who, items);
                 }
             }
         }
@@ -1236,11 +1366,11 @@ impl ModelDescription {
                 ));
                 None
             }
-            Some(t) if t.value_type() != v.value_type() => {
+            Some(t) if t.kind.element() != v.kind.element() => {
                 errors.push(format!(
                     "variable '{n}': declaredType '{name}' is a {} type but the variable is {}",
-                    t.value_type().as_str(),
-                    v.value_type().as_str()
+                    t.kind.element(),
+                    v.kind.element()
                 ));
                 None
             }
@@ -1402,6 +1532,17 @@ impl ModelDescription {
             VariableKind::String { start } => {
                 if let Some(s) = start {
                     check_text(errors, &format!("start of variable '{n}'"), s);
+                }
+            }
+            VariableKind::Enumeration { start, .. } => {
+                if let (Some(s), Some(t)) = (start, declared) {
+                    if !t.items().iter().any(|i| i.value == *s) {
+                        errors.push(format!(
+                            "variable '{n}': start {s} is not an item of its declaredType '{}' ({})",
+                            t.name,
+                            items_text(t.items())
+                        ));
+                    }
                 }
             }
         }
@@ -1688,7 +1829,7 @@ fn write_simple_type(x: &mut String, t: &SimpleType) {
         attr(x, "description", &t.description);
     }
     x.push_str(">\n      <");
-    x.push_str(t.value_type().as_str());
+    x.push_str(t.kind.element());
     match &t.kind {
         SimpleTypeKind::Real {
             quantity,
@@ -1724,6 +1865,23 @@ fn write_simple_type(x: &mut String, t: &SimpleType) {
                 attr(x, "max", &m.to_string());
             }
         }
+        SimpleTypeKind::Enumeration { quantity, items } => {
+            if let Some(q) = quantity {
+                attr(x, "quantity", q);
+            }
+            x.push_str(">\n");
+            for item in items {
+                x.push_str("        <Item");
+                attr(x, "name", &item.name);
+                attr(x, "value", &item.value.to_string());
+                if !item.description.is_empty() {
+                    attr(x, "description", &item.description);
+                }
+                x.push_str("/>\n");
+            }
+            x.push_str("      </Enumeration>\n    </SimpleType>\n");
+            return;
+        }
     }
     x.push_str("/>\n    </SimpleType>\n");
 }
@@ -1743,7 +1901,7 @@ fn write_variable(x: &mut String, index: usize, v: &Variable) {
         attr(x, "initial", initial.as_str());
     }
     x.push_str(">\n      <");
-    x.push_str(v.value_type().as_str());
+    x.push_str(v.kind.element());
     if let Some(t) = v.kind.declared_type() {
         attr(x, "declaredType", t);
     }
@@ -1798,6 +1956,11 @@ fn write_variable(x: &mut String, index: usize, v: &Variable) {
                 attr(x, "start", s);
             }
         }
+        VariableKind::Enumeration { start, .. } => {
+            if let Some(s) = start {
+                attr(x, "start", &s.to_string());
+            }
+        }
     }
     x.push_str("/>\n    </ScalarVariable>\n");
 }
@@ -1826,6 +1989,43 @@ fn check_range<T: PartialOrd + std::fmt::Display + Copy>(
                 errors.push(format!("{who}: start {s} is above max {hi}"));
             }
         }
+    }
+}
+
+/// The items of an Enumeration type (FMI 2.0 section 2.2.3): at least one (the schema's
+/// `Item` is a required, unbounded sequence), each with a non-empty name, names and
+/// values unique within the type, XML-representable text.
+fn check_items(errors: &mut Vec<String>, who: &str, items: &[EnumerationItem]) {
+    if items.is_empty() {
+        errors.push(format!("{who}: an Enumeration needs at least one Item"));
+    }
+    let mut names = HashSet::new();
+    let mut values = HashMap::new();
+    for item in items {
+        if item.name.is_empty() {
+            errors.push(format!(
+                "{who}: item of value {} has an empty name",
+                item.value
+            ));
+        } else if !names.insert(item.name.as_str()) {
+            errors.push(format!("{who}: item name '{}' is used twice", item.name));
+        }
+        if let Some(other) = values.insert(item.value, item.name.as_str()) {
+            errors.push(format!(
+                "{who}: items '{other}' and '{}' have the same value {}",
+                item.name, item.value
+            ));
+        }
+        check_text(
+            errors,
+            &format!("item '{}' of {who}", item.name),
+            &item.name,
+        );
+        check_text(
+            errors,
+            &format!("description of item '{}' of {who}", item.name),
+            &item.description,
+        );
     }
 }
 

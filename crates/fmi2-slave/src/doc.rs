@@ -5,7 +5,8 @@
 
 use crate::description::{fmt_f64, ModelDescription, Variable, VariableKind};
 
-fn start_text(v: &Variable) -> String {
+/// The start value; an Enumeration's with its item's name (`1 (distributed)`).
+fn start_text(md: &ModelDescription, v: &Variable) -> String {
     match &v.kind {
         VariableKind::Real { start, .. } => start.map(fmt_f64).unwrap_or_default(),
         VariableKind::Integer { start, .. } => start.map(|s| s.to_string()).unwrap_or_default(),
@@ -13,6 +14,20 @@ fn start_text(v: &Variable) -> String {
         VariableKind::String { start } => start
             .as_ref()
             .map(|s| format!("\"{s}\""))
+            .unwrap_or_default(),
+        VariableKind::Enumeration {
+            declared_type,
+            start,
+        } => start
+            .map(|s| {
+                let item = md
+                    .simple_type(declared_type)
+                    .and_then(|t| t.items().iter().find(|i| i.value == s));
+                match item {
+                    Some(i) => format!("{s} ({})", i.name),
+                    None => s.to_string(),
+                }
+            })
             .unwrap_or_default(),
     }
 }
@@ -31,10 +46,10 @@ fn unit_text(v: &Variable) -> String {
     }
 }
 
-/// The base type, with the declared type in parentheses when there is one
-/// (`Real (Angle)`).
+/// The type element, with the declared type in parentheses when there is one
+/// (`Real (Angle)`, `Enumeration (Architecture)`).
 fn type_text(v: &Variable) -> String {
-    let base = v.value_type().as_str();
+    let base = v.kind.element();
     match v.kind.declared_type() {
         Some(t) => format!("{base} ({t})"),
         None => base.to_string(),
@@ -68,14 +83,38 @@ pub fn variables_markdown(md: &ModelDescription) -> String {
             v.variability.as_str(),
             md_escape(&type_text(v)),
             md_escape(&unit_text(v)),
-            md_escape(&start_text(v)),
+            md_escape(&start_text(md, v)),
             v.value_reference,
             md_escape(&v.description),
         ));
     }
+    out.push_str(&enumerations_markdown(md));
     out.push_str("\nLog categories (`fmi2SetDebugLogging`):\n\n");
     for c in &md.log_categories {
         out.push_str(&format!("- `{}`: {}\n", c.name, md_escape(&c.description)));
+    }
+    out
+}
+
+/// The Enumeration types and their items (FMI 2.0 section 2.2.3), a list; empty without
+/// any.
+fn enumerations_markdown(md: &ModelDescription) -> String {
+    let mut out = String::new();
+    for t in md.type_definitions.iter().filter(|t| !t.items().is_empty()) {
+        if out.is_empty() {
+            out.push_str(
+                "\nEnumeration types (values set and read with `fmi2SetInteger`/`fmi2GetInteger`):\n\n",
+            );
+        }
+        let items: Vec<String> = t
+            .items()
+            .iter()
+            .map(|i| match i.description.as_str() {
+                "" => format!("{} `{}`", i.value, i.name),
+                d => format!("{} `{}`: {}", i.value, i.name, md_escape(d)),
+            })
+            .collect();
+        out.push_str(&format!("- `{}`: {}\n", t.name, items.join("; ")));
     }
     out
 }
@@ -91,7 +130,7 @@ pub fn documentation_html(md: &ModelDescription) -> String {
             v.variability.as_str(),
             html_escape(&type_text(v)),
             html_escape(&unit_text(v)),
-            html_escape(&start_text(v)),
+            html_escape(&start_text(md, v)),
             v.value_reference,
             html_escape(&v.description),
         ));
@@ -183,6 +222,41 @@ mod tests {
         );
         assert!(text.contains("`logStatusError`"));
         assert_eq!(m.variables[0].causality, Causality::Parameter);
+    }
+
+    #[test]
+    fn enumerations_show_their_type_start_item_and_items() {
+        use crate::description::EnumerationItem;
+        let mut m = md();
+        m.type_definitions.push(SimpleType::enumeration(
+            "Method",
+            "",
+            vec![
+                EnumerationItem::new("euler", 1, "explicit Euler"),
+                EnumerationItem::new("heun", 2, "a | b"),
+            ],
+        ));
+        m.variables.push(Variable::enumeration_parameter(
+            "method",
+            3,
+            "Method",
+            2,
+            Variability::Fixed,
+            "integration",
+        ));
+        let text = variables_markdown(&m);
+        assert!(
+            text.contains(
+                "| `method` | parameter | fixed | Enumeration (Method) |  | 2 (heun) | 3 | integration |"
+            ),
+            "{text}"
+        );
+        assert!(
+            text.contains("- `Method`: 1 `euler`: explicit Euler; 2 `heun`: a \\| b\n"),
+            "{text}"
+        );
+        // Without an Enumeration type, no list.
+        assert!(!variables_markdown(&md()).contains("Enumeration types"));
     }
 
     #[test]

@@ -52,6 +52,9 @@ impl Tag {
 }
 
 /// Value-reference lookup built once per instance: per type, `(vr, position)` sorted by vr.
+/// Enumeration variables are listed with the Integers: their value references share that
+/// numbering and `fmi2GetInteger`/`fmi2SetInteger` access them (FMI 2.0 sections 2.1.7,
+/// 2.2.7).
 struct VarIndex {
     by_type: [Vec<(u32, usize)>; 4],
 }
@@ -137,7 +140,7 @@ impl<M: Fmi2Model> Instance<M> {
             Some(v) => format!(
                 "value reference {vr} does not name a variable of type {} (it names the {} variable '{}')",
                 ty.as_str(),
-                v.value_type().as_str(),
+                v.kind.element(),
                 v.name
             ),
             None => format!("unknown value reference {vr}: no {} variable has it", ty.as_str()),
@@ -753,7 +756,7 @@ pub unsafe fn get_real<M: Fmi2Model>(
     }
 }
 
-/// `fmi2GetInteger` (FMI 2.0 section 2.1.7).
+/// `fmi2GetInteger` (FMI 2.0 section 2.1.7): Integer and Enumeration variables.
 pub unsafe fn get_integer<M: Fmi2Model>(
     c: Fmi2Component,
     vr: *const Fmi2ValueReference,
@@ -861,7 +864,9 @@ pub unsafe fn set_real<M: Fmi2Model>(
     }
 }
 
-/// `fmi2SetInteger` (FMI 2.0 section 2.1.7).
+/// `fmi2SetInteger` (FMI 2.0 section 2.1.7): Integer and Enumeration variables. Whether a
+/// value lies in an Integer's range or is one of an Enumeration's items is the model's
+/// check (its setter's error names the variable, the value and what it accepts).
 pub unsafe fn set_integer<M: Fmi2Model>(
     c: Fmi2Component,
     vr: *const Fmi2ValueReference,

@@ -64,8 +64,9 @@ mod uri;
 use std::path::Path;
 
 pub use description::{
-    BaseUnit, Causality, DefaultExperiment, DisplayUnit, Initial, LogCategory, ModelDescription,
-    SimpleType, SimpleTypeKind, UnitDefinition, ValueType, Variability, Variable, VariableKind,
+    BaseUnit, Causality, DefaultExperiment, DisplayUnit, EnumerationItem, Initial, LogCategory,
+    ModelDescription, SimpleType, SimpleTypeKind, UnitDefinition, ValueType, Variability, Variable,
+    VariableKind,
 };
 pub use ffi::Fmi2Status;
 pub use logger::Logger;

@@ -875,6 +875,61 @@ fn get_and_set_every_type_vectorised() {
     }
 }
 
+/// An Enumeration variable is read and written with fmi2GetInteger/fmi2SetInteger (FMI 2.0
+/// section 2.1.7) under the Integer value-reference numbering; the other typed functions
+/// refuse it naming it as an Enumeration, and a value that is not one of its items is the
+/// model's refusal (fmi2Error naming the variable, the value and the items).
+#[test]
+fn enumeration_variables_are_set_and_read_as_integers() {
+    let f = fresh_in("initializationMode");
+    assert_eq!(f.get_integer(E_METHOD), METHOD_EULER);
+    assert_eq!(f.set_integer(E_METHOD, METHOD_HEUN), Fmi2Status::Ok);
+    assert_eq!(f.get_integer(E_METHOD), METHOD_HEUN);
+    // vectorised with plain Integers
+    let vrs = [I_SUBSTEPS, E_METHOD];
+    let mut out = [-1; 2];
+    unsafe {
+        assert_eq!(
+            fmi2GetInteger(f.c, vrs.as_ptr(), 2, out.as_mut_ptr()),
+            Fmi2Status::Ok
+        );
+    }
+    assert_eq!(out, [4, METHOD_HEUN]);
+    // The value reaches the model: Heun's step differs from Euler's.
+    assert_eq!(f.exit_init(), Fmi2Status::Ok);
+    assert_eq!(f.set_real(R_U, 1.0), Fmi2Status::Ok);
+    assert_eq!(f.step(0.0, 0.4), Fmi2Status::Ok);
+    let heun = f.get_real(R_Y);
+    let euler = new_fmu("euler");
+    euler.init(0.0, None);
+    assert_eq!(euler.set_real(R_U, 1.0), Fmi2Status::Ok);
+    assert_eq!(euler.step(0.0, 0.4), Fmi2Status::Ok);
+    // y' = 1 - y from 0 over 0.4 s: exactly 1 - e^-0.4; Heun is second order.
+    let exact = 1.0 - (-0.4f64).exp();
+    let euler = euler.get_real(R_Y);
+    assert!(
+        (heun - exact).abs() < 0.1 * (euler - exact).abs(),
+        "heun {heun}, euler {euler}, exact {exact}"
+    );
+    // Tunable: settable after initialization; a value not among the items is refused.
+    assert_eq!(f.set_integer(E_METHOD, METHOD_EULER), Fmi2Status::Ok);
+    assert_eq!(f.set_integer(E_METHOD, 3), Fmi2Status::Error);
+    assert_eq!(
+        f.last_text(),
+        "fmi2SetInteger: variable 'method' (vr 6): method must be one of 1 euler, 2 heun, got 3"
+    );
+    // Another type's function names it as the Enumeration it is.
+    let g = fresh_in("stepComplete");
+    let mut r = 0.0;
+    unsafe {
+        assert_eq!(fmi2GetReal(g.c, &E_METHOD, 1, &mut r), Fmi2Status::Error);
+    }
+    assert_eq!(
+        g.last_text(),
+        "fmi2GetReal: value reference 6 does not name a variable of type Real (it names the Enumeration variable 'method')"
+    );
+}
+
 #[test]
 fn warnings_are_always_logged_with_percent_s_and_nul_replaced() {
     let f = fresh_in("stepComplete"); // loggingOn = false

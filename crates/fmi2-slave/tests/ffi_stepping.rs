@@ -357,7 +357,7 @@ fn deserialize_names_what_does_not_match() {
     let good = a.serialize();
     let id_at = 8 + 4 + 4; // magic, version, identifier length
     let guid_at = id_at + 3 + 4 + 1; // "Lag", GUID length, '{'
-    let model_at = good.len() - 50 - 3; // Lag state: 50 bytes + label "lag"
+    let model_at = good.len() - 54 - 3; // Lag state: 54 bytes + label "lag"
     let mut cases: Vec<(Vec<u8>, &str)> = Vec::new();
     let mut m = good.clone();
     m[0] ^= 1;

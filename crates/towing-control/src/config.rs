@@ -6,6 +6,7 @@
 use std::sync::Arc;
 
 use towing_guidance::{GuidanceParams, GuidanceSettings, Route};
+use towing_model::registry::{Enumeration, Item};
 use towing_model::{HullDynamics, HullModel, Scenario};
 use towing_mpc::{
     AdmmSettings, CentralizedSettings, PredictionParams, ShipMpcParams, TugMpcParams,
@@ -26,17 +27,37 @@ pub enum Architecture {
 }
 
 impl Architecture {
-    /// From the FMI code (1 or 2).
+    /// The FMI Enumeration type `Architecture` of the parameter `architecture` (FMI 2.0
+    /// section 2.2.3): 1 `distributed`, 2 `centralized`, the codes masters have always
+    /// set.
+    pub const ENUMERATION: Enumeration = Enumeration {
+        name: "Architecture",
+        description: "Which MPC computes the commands",
+        items: &[
+            Item {
+                name: "distributed",
+                value: 1,
+                description: "ADMM over the coordination (ship) and the tug problems (Du et al. 2022, Algorithm 1; the paper's method)",
+            },
+            Item {
+                name: "centralized",
+                value: 2,
+                description: "one MPC over all inputs (Du et al. 2022, eq. (12); the paper's Table 7 comparison)",
+            },
+        ],
+    };
+
+    /// From the FMI code (an item's value of [`Architecture::ENUMERATION`]).
     ///
     /// # Errors
-    /// Any other code.
+    /// Any other code, naming the items.
     pub fn from_code(code: i32) -> Result<Self, ConfigError> {
         match code {
             1 => Ok(Architecture::Distributed),
             2 => Ok(Architecture::Centralized),
             _ => Err(ConfigError::new(
                 "architecture",
-                format!("must be 1 (distributed) or 2 (centralized), got {code}"),
+                Self::ENUMERATION.refusal(code),
             )),
         }
     }
@@ -66,10 +87,35 @@ pub enum AvoidanceScheme {
 }
 
 impl AvoidanceScheme {
-    /// From the FMI code (1, 2 or 3).
+    /// The FMI Enumeration type `AvoidanceScheme` of the parameter `avoidance_scheme`
+    /// (FMI 2.0 section 2.2.3): the paper's schemes I, II, III as 1 `alter_and_cost`,
+    /// 2 `alter_only`, 3 `cost_only`, the codes masters have always set.
+    pub const ENUMERATION: Enumeration = Enumeration {
+        name: "AvoidanceScheme",
+        description: "The paper's avoidance schemes (Du et al. 2022, section 4.2)",
+        items: &[
+            Item {
+                name: "alter_and_cost",
+                value: 1,
+                description: "scheme I: waypoint altering (eq. (8)-(11)) and the distance cost (eq. (13)), the paper's main scheme",
+            },
+            Item {
+                name: "alter_only",
+                value: 2,
+                description: "scheme II: waypoint altering only (the distance weights forced to 0)",
+            },
+            Item {
+                name: "cost_only",
+                value: 3,
+                description: "scheme III: the distance cost only (the unaltered route)",
+            },
+        ],
+    };
+
+    /// From the FMI code (an item's value of [`AvoidanceScheme::ENUMERATION`]).
     ///
     /// # Errors
-    /// Any other code.
+    /// Any other code, naming the items.
     pub fn from_code(code: i32) -> Result<Self, ConfigError> {
         match code {
             1 => Ok(AvoidanceScheme::AlterAndCost),
@@ -77,7 +123,7 @@ impl AvoidanceScheme {
             3 => Ok(AvoidanceScheme::CostOnly),
             _ => Err(ConfigError::new(
                 "avoidance_scheme",
-                format!("must be 1 (I), 2 (II) or 3 (III), got {code}"),
+                Self::ENUMERATION.refusal(code),
             )),
         }
     }

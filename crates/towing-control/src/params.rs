@@ -22,7 +22,10 @@
 //! `architecture` and `avoidance_scheme` keep their ungrouped names (the masters
 //! and the interface contract use them). Every Real declares its unit, one unit
 //! per name; a value that comes from the scenario has a Boolean switch
-//! (`mpc.hull_from_scenario`, `waterway.from_scenario`), never a sentinel value.
+//! (`mpc.hull_from_scenario`, `waterway.from_scenario`), never a sentinel value; a
+//! choice is an FMI Enumeration whose items keep the codes masters have always set
+//! (`architecture` [`Architecture::ENUMERATION`], `avoidance_scheme`
+//! [`AvoidanceScheme::ENUMERATION`], `mpc.hull_model` [`HullModel::ENUMERATION`]).
 
 use towing_model::registry;
 use towing_model::HullModel;
@@ -41,23 +44,6 @@ pub type Kind = registry::Kind<Tuning>;
 #[must_use]
 pub fn find(name: &str) -> Option<&'static Parameter> {
     registry::find(PARAMETERS, name)
-}
-
-/// The FMI code of a built-in hull (`mpc.hull_model`).
-fn hull_code(h: HullModel) -> i32 {
-    match h {
-        HullModel::LinearDamping => 1,
-        HullModel::NonlinearDamping => 2,
-    }
-}
-
-/// The built-in hull of an FMI code (`mpc.hull_model`, checked to be 1 or 2).
-fn hull_of(code: i32) -> HullModel {
-    if code == 1 {
-        HullModel::LinearDamping
-    } else {
-        HullModel::NonlinearDamping
-    }
 }
 
 /// The rules between parameters, after each one's range: `F_min <= F_max`, at
@@ -103,22 +89,22 @@ pub static PARAMETERS: &[Parameter] = &[
     Parameter {
         name: "architecture",
         old_name: Some("architecture"),
-        description: "1 distributed MPC, ADMM over the coordination and the tug problems (Du et al. 2022, Algorithm 1; the paper's method), 2 centralized MPC over all inputs (eq. (12), the paper's Table 7 comparison)",
-        kind: Kind::Integer {
-            min: 1,
-            max: 2,
+        description: "Which MPC computes the commands: distributed, ADMM over the coordination and the tug problems (Du et al. 2022, Algorithm 1; the paper's method), or centralized, one MPC over all inputs (eq. (12); the paper's Table 7 comparison)",
+        kind: Kind::Enumeration {
+            enumeration: &Architecture::ENUMERATION,
             get: |t| t.architecture.code(),
+            // Only an item's value reaches the setter (`Parameter::set`).
             set: |t, v| t.architecture = Architecture::from_code(v).unwrap_or_default(),
         },
     },
     Parameter {
         name: "avoidance_scheme",
         old_name: Some("avoidance_scheme"),
-        description: "The paper's avoidance schemes (section 4.2): 1 (I) waypoint altering and distance cost, the paper's main scheme; 2 (II) altering only (the distance weights forced to 0); 3 (III) distance cost only (unaltered route)",
-        kind: Kind::Integer {
-            min: 1,
-            max: 3,
+        description: "The paper's avoidance schemes (Du et al. 2022, section 4.2): I waypoint altering and distance cost, the paper's main scheme; II altering only (the distance weights forced to 0); III distance cost only (unaltered route)",
+        kind: Kind::Enumeration {
+            enumeration: &AvoidanceScheme::ENUMERATION,
             get: |t| t.scheme.code(),
+            // Only an item's value reaches the setter (`Parameter::set`).
             set: |t, v| t.scheme = AvoidanceScheme::from_code(v).unwrap_or_default(),
         },
     },
@@ -170,12 +156,12 @@ pub static PARAMETERS: &[Parameter] = &[
     Parameter {
         name: "mpc.hull_model",
         old_name: Some("hull_model"),
-        description: "Hull damping of the MPC's prediction models when mpc.hull_from_scenario is false: 1 linear (constant D, the paper's eq. (1)), 2 nonlinear (Skjetne et al. 2004)",
-        kind: Kind::Integer {
-            min: 1,
-            max: 2,
-            get: |t| hull_code(t.hull),
-            set: |t, v| t.hull = hull_of(v),
+        description: "Hull damping of the MPC's prediction models when mpc.hull_from_scenario is false: linear_damping (constant D, the paper's eq. (1)) or nonlinear_damping (Skjetne et al. 2004)",
+        kind: Kind::Enumeration {
+            enumeration: &HullModel::ENUMERATION,
+            get: |t| t.hull.code(),
+            // Only an item's value reaches the setter (`Parameter::set`).
+            set: |t, v| t.hull = HullModel::from_code(v).unwrap_or_default(),
         },
     },
     Parameter {
@@ -777,8 +763,20 @@ mod tests {
                 }
                 Kind::Integer { min, max, .. } => Value::Integer(max.min(min + 1)),
                 Kind::Boolean { get, .. } => Value::Boolean(!get(&t)),
+                // An item other than the default.
+                Kind::Enumeration {
+                    enumeration, get, ..
+                } => Value::Integer(
+                    enumeration
+                        .items
+                        .iter()
+                        .map(|i| i.value)
+                        .find(|&v| v != get(&t))
+                        .unwrap(),
+                ),
+                Kind::String { .. } => unreachable!("the controller has no String parameter"),
             };
-            p.set(&mut t, v).unwrap();
+            p.set(&mut t, v.clone()).unwrap();
             assert_eq!(p.get(&t), v, "{}", p.name);
         }
     }
@@ -808,11 +806,68 @@ mod tests {
             .check(&Value::Boolean(true))
             .unwrap_err();
         assert!(e.to_string().contains("expects a Real value"), "{e}");
+        let e: ConfigError = find("architecture")
+            .unwrap()
+            .check(&Value::Integer(3))
+            .unwrap_err()
+            .into();
+        assert_eq!(
+            e.to_string(),
+            "parameter `architecture`: must be one of 1 distributed, 2 centralized, got 3"
+        );
         let mut t = Tuning::default();
         t.ship.min_tension = 5.0;
         assert_eq!(
             t.validate().unwrap_err().to_string(),
             "parameter `mpc.ship.min_tension`: must be <= mpc.ship.max_tension = 3 N, got 5 N"
         );
+    }
+
+    /// The choices keep the codes masters set before they were enumerations, and every
+    /// item maps to its Rust value and back.
+    #[test]
+    fn choices_are_enumerations_with_the_codes_masters_use() {
+        let codes = |name: &str| match find(name).unwrap().kind {
+            Kind::Enumeration { enumeration, .. } => enumeration
+                .items
+                .iter()
+                .map(|i| (i.value, i.name))
+                .collect::<Vec<_>>(),
+            other => panic!("{name} is {other:?}"),
+        };
+        assert_eq!(
+            codes("architecture"),
+            [(1, "distributed"), (2, "centralized")]
+        );
+        assert_eq!(
+            codes("avoidance_scheme"),
+            [(1, "alter_and_cost"), (2, "alter_only"), (3, "cost_only")]
+        );
+        assert_eq!(
+            codes("mpc.hull_model"),
+            [(1, "linear_damping"), (2, "nonlinear_damping")]
+        );
+        for item in Architecture::ENUMERATION.items {
+            assert_eq!(
+                Architecture::from_code(item.value).map(Architecture::code),
+                Ok(item.value)
+            );
+        }
+        for item in AvoidanceScheme::ENUMERATION.items {
+            assert_eq!(
+                AvoidanceScheme::from_code(item.value).map(AvoidanceScheme::code),
+                Ok(item.value)
+            );
+        }
+        assert_eq!(
+            AvoidanceScheme::from_code(4).unwrap_err().to_string(),
+            "parameter `avoidance_scheme`: must be one of 1 alter_and_cost, 2 alter_only, 3 cost_only, got 4"
+        );
+        let mut t = Tuning::default();
+        find("mpc.hull_model")
+            .unwrap()
+            .set(&mut t, Value::Integer(1))
+            .unwrap();
+        assert_eq!(t.hull, HullModel::LinearDamping);
     }
 }

@@ -1,8 +1,9 @@
 //! No configuration the registry accepts can panic the controller: random values
-//! within every parameter's range (each Real log-uniform between its lower bound, or
-//! a hundredth of its default, and its upper bound, or a hundred times its
-//! default), a controller built from them when `validate` passes, and samples of
-//! the paper scenario's closed loop through `Controller::step`.
+//! within every parameter's range (any item of an Enumeration; each Real
+//! log-uniform between its lower bound, or a hundredth of its default, and its
+//! upper bound, or a hundred times its default), a controller built from them when
+//! `validate` passes, and samples of the paper scenario's closed loop through
+//! `Controller::step`.
 #![allow(clippy::unwrap_used)]
 
 use proptest::prelude::*;
@@ -40,6 +41,10 @@ fn draw(kind: Kind, default: Value, u: f64, b: bool) -> Value {
             Value::Integer(min + ((u * f64::from(max - min + 1)) as i32).min(max - min))
         }
         (Kind::Boolean { .. }, _) => Value::Boolean(b),
+        (Kind::Enumeration { enumeration, .. }, _) => {
+            let n = enumeration.items.len();
+            Value::Integer(enumeration.items[((u * n as f64) as usize).min(n - 1)].value)
+        }
         (_, other) => other,
     }
 }

@@ -226,14 +226,11 @@ impl ObstacleField {
 }
 
 /// Every variable a master connects between the two FMUs (DESIGN.md, "Interface
-/// contract"), plus the String parameters both declare. Which FMU outputs which: crate
-/// docs.
+/// contract"). Which FMU outputs which: crate docs. The String parameters both FMUs
+/// declare (`scenario`, `log_file`, `run_id`) are the session's
+/// ([`crate::session::PARAMETERS`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ContractVariable {
-    /// `scenario` (String parameter).
-    Scenario,
-    /// `log_file` (String parameter).
-    LogFile,
     /// `ship.x` .. `tug2.r` (Real).
     VesselState(Vessel, StateComponent),
     /// `tug1.force_surge` .. `tug2.moment_yaw` (Real).
@@ -264,9 +261,7 @@ impl ContractVariable {
             .into_iter()
             .flat_map(|l| TowlineField::ALL.map(|f| C::Towline(l, f)));
         let obstacles = Slot::all().flat_map(|s| ObstacleField::ALL.map(|f| C::Obstacle(s, f)));
-        [C::Scenario, C::LogFile]
-            .into_iter()
-            .chain(states)
+        states
             .chain(forces)
             .chain(Towline::ALL.map(C::TensionCmd))
             .chain(towlines)
@@ -280,8 +275,6 @@ impl ContractVariable {
         use ContractVariable as C;
         // The indices are below 10 (MAX_OBSTACLES = 8): the casts are exact.
         match self {
-            C::Scenario => vr::SCENARIO,
-            C::LogFile => vr::LOG_FILE,
             C::VesselState(v, c) => vr::vessel_state(v.index() as u32, c.index() as u32),
             C::TugForce(t, c) => vr::tug_force(t.index() as u32, c.index() as u32),
             C::TensionCmd(l) => vr::tension_cmd(l.index() as u32),
@@ -303,7 +296,6 @@ impl ContractVariable {
     pub const fn value_type(self) -> ValueType {
         use ContractVariable as C;
         match self {
-            C::Scenario | C::LogFile => ValueType::String,
             C::Towline(_, TowlineField::Slack) => ValueType::Boolean,
             C::Obstacle(_, ObstacleField::Kind) => ValueType::Integer,
             _ => ValueType::Real,
@@ -315,8 +307,6 @@ impl ContractVariable {
     pub fn name(self) -> String {
         use ContractVariable as C;
         match self {
-            C::Scenario => "scenario".to_owned(),
-            C::LogFile => "log_file".to_owned(),
             C::VesselState(v, c) => format!("{}.{}", v.name(), c.name()),
             C::TugForce(t, c) => format!("{}.{}", t.name(), c.name()),
             C::TensionCmd(l) => format!("{}.tension_cmd", l.name()),
@@ -519,9 +509,8 @@ mod tests {
     #[test]
     fn every_contract_variable_decodes_to_itself() {
         let all: Vec<ContractVariable> = ContractVariable::all().collect();
-        // 2 String parameters, 18 states, 6 forces, 2 tension commands, 8 towline fields,
-        // 7 fields of 8 slots.
-        assert_eq!(all.len(), 2 + 18 + 6 + 2 + 8 + 7 * MAX_OBSTACLES);
+        // 18 states, 6 forces, 2 tension commands, 8 towline fields, 7 fields of 8 slots.
+        assert_eq!(all.len(), 18 + 6 + 2 + 8 + 7 * MAX_OBSTACLES);
         for &v in &all {
             assert_eq!(ContractVariable::decode(v.encode()), Ok(v), "{}", v.name());
         }
@@ -539,8 +528,6 @@ mod tests {
         use ContractVariable as C;
         let slot = |k| Slot::new(k).unwrap();
         for (v, vr) in [
-            (C::Scenario, 1),
-            (C::LogFile, 2),
             (C::VesselState(Vessel::Ship, StateComponent::X), 100),
             (C::VesselState(Vessel::Tug2, StateComponent::R), 125),
             (C::TugForce(Tug::Tug1, ForceComponent::Surge), 200),
@@ -566,7 +553,8 @@ mod tests {
 
     #[test]
     fn unknown_references_are_named_with_their_type() {
-        for vr in [0, 3, 99, 126, 222, 314, 1007, 1080, u32::MAX] {
+        // 1, 2, 3: the session's parameters, not the contract's.
+        for vr in [0, 1, 3, 99, 126, 222, 314, 1007, 1080, u32::MAX] {
             let e = ContractVariable::decode(vr).unwrap_err();
             assert_eq!(
                 e.to_string(),

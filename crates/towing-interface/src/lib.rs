@@ -14,11 +14,15 @@
 //!   that reads them), and the generic parameter/input/output builders.
 //! * [`types`]: the units and declared types, and the model-description skeleton
 //!   ([`ModelInfo`]).
+//! * [`parameters`]: an FMU's parameter registry as FMI variables (value references,
+//!   types, model-description variables, Enumeration types, the values as JSON), for
+//!   both FMUs.
 //! * [`scenario`]: the `scenario` String parameter (a file path, or the bundled
 //!   `resources/paper.toml`).
-//! * [`session`]: the scenario and log life cycle both FMUs share ([`RunSession`]): the
-//!   `scenario` and `log_file` parameters, the scenario as loaded, the MCAP log opened with
-//!   the run description and finished at terminate or release.
+//! * [`session`]: the scenario and log life cycle both FMUs share ([`RunSession`]): its
+//!   registry of String parameters `scenario`, `log_file` and `run_id`
+//!   ([`session::PARAMETERS`], in both FMUs before their own), the scenario as loaded, the
+//!   MCAP log opened with the run description and finished at terminate or release.
 //! * [`model_description_main`]: the body of each FMU's model description binary (`plant_model_description`, `controller_model_description`).
 //! * `testing` (feature `testing`): in-process test helpers shared by the FMU crates.
 //!
@@ -29,6 +33,7 @@
 #![warn(missing_docs)]
 
 pub mod codec;
+pub mod parameters;
 pub mod scenario;
 pub mod session;
 pub mod types;
@@ -73,15 +78,17 @@ pub const COMMANDS: [u32; 8] = {
     ]
 };
 
-/// The names of DESIGN.md's interface contract every FMU declares: the vessel states, the
-/// commands, the towline values, the obstacle slots, `scenario` and `log_file` (every
-/// [`ContractVariable`] but the plant's own `towlineN.slack`).
+/// The names of DESIGN.md's interface contract every FMU declares: the session's
+/// parameters (`scenario`, `log_file`, `run_id`), the vessel states, the commands, the
+/// towline values, the obstacle slots (every [`ContractVariable`] but the plant's own
+/// `towlineN.slack`).
 #[must_use]
 pub fn contract_names() -> Vec<String> {
-    ContractVariable::all()
+    let session = session::PARAMETERS.iter().map(|p| p.name.to_owned());
+    let connected = ContractVariable::all()
         .filter(|v| !matches!(v, ContractVariable::Towline(_, TowlineField::Slack)))
-        .map(ContractVariable::name)
-        .collect()
+        .map(ContractVariable::name);
+    session.chain(connected).collect()
 }
 
 /// The body of an FMU's model description binary: prints `description` as

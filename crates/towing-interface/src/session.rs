@@ -1,6 +1,7 @@
-//! The scenario and log life cycle both FMUs share ([`RunSession`]): the `scenario` and
-//! `log_file` parameters, the resources folder, the scenario as loaded (with its text, so a
-//! saved FMU state does not depend on the file still existing) and the MCAP log
+//! The scenario and log life cycle both FMUs share ([`RunSession`]): the String parameters
+//! `scenario`, `log_file` and `run_id` (the session's registry, [`PARAMETERS`], which both
+//! FMUs declare before their own), the resources folder, the scenario as loaded (with its
+//! text, so a saved FMU state does not depend on the file still existing) and the MCAP log
 //! (docs/logging.md), opened with the run description when initialization ends and finished
 //! at `fmi2Terminate`, or at `fmi2FreeInstance` / `fmi2Reset` when terminate did not.
 
@@ -8,7 +9,64 @@ use crate::scenario::ScenarioFile;
 use fmi2_slave::Logger;
 use std::path::{Path, PathBuf};
 use towing_log::{LogError, LogOptions, LogWriter, RunInfo, SharedLog};
+use towing_model::registry::{self, Kind, Value};
 use towing_model::Scenario;
+
+/// A parameter of the session.
+pub type Parameter = registry::Parameter<RunSession>;
+
+/// Index of `scenario` in [`PARAMETERS`] (setting it reads the scenario again during
+/// initialization).
+pub const SCENARIO: usize = 0;
+
+/// The session's parameters, the same in both FMUs (value references
+/// [`crate::vr::session_parameter`]: `scenario` 1, `log_file` 2, `run_id` 3). Their names
+/// are those of the interface contract (DESIGN.md), which masters set.
+pub static PARAMETERS: &[Parameter] = &[
+    Parameter {
+        name: "scenario",
+        old_name: None,
+        description: "Path of the scenario file (TOML, docs/scenario-format.md); empty: the bundled paper scenario resources/paper.toml. Give both FMUs the same file: the plant takes the vessels, the traffic and the physics from it, the controller its prediction models, formation, route and waterway. Read at fmi2EnterInitializationMode, and again when set during initialization",
+        kind: Kind::String {
+            get: |s| &s.scenario_parameter,
+            set: |s, v| {
+                v.clone_into(&mut s.scenario_parameter);
+                Ok(())
+            },
+        },
+    },
+    Parameter {
+        name: "log_file",
+        old_name: None,
+        description: "Path of the MCAP log of this unit (docs/logging.md), created (replaced) at fmi2ExitInitializationMode and closed at fmi2Terminate; empty: no log",
+        kind: Kind::String {
+            get: |s| &s.log_file,
+            set: |s, v| {
+                s.set_log_file(v);
+                Ok(())
+            },
+        },
+    },
+    Parameter {
+        name: "run_id",
+        old_name: None,
+        description: "Identifier of the run, given by the user or the master (masters/closed_loop.py gives both FMUs the same generated one): written into the run description of the MCAP log (docs/logging.md), so the analyzer can tell whether a plant log and a controller log belong to the same run; empty: none. One line, no control characters",
+        kind: Kind::String {
+            get: |s| &s.run_id,
+            set: |s, v| {
+                if let Some(c) = v.chars().find(|c| c.is_control()) {
+                    return Err(format!(
+                        "must not contain control characters (it is one line of the log's run description), got {:?} with U+{:04X}",
+                        v,
+                        u32::from(c)
+                    ));
+                }
+                v.clone_into(&mut s.run_id);
+                Ok(())
+            },
+        },
+    },
+];
 
 /// What the run description of an FMU's log holds besides the scenario
 /// ([`RunSession::open_log`]).
@@ -22,27 +80,29 @@ pub struct LogHeader<'a> {
     pub version: &'a str,
     /// `fmi2SetupExperiment`'s start time (s).
     pub start_time: f64,
-    /// Every parameter's value, a JSON object.
-    pub parameters: serde_json::Value,
+    /// The value of every parameter of the FMU's registry
+    /// ([`crate::parameters::values_json`]); the session adds its own.
+    pub parameters: serde_json::Map<String, serde_json::Value>,
 }
 
-/// The `scenario` and `log_file` parameters of an FMU instance, the scenario they loaded
+/// The session's parameters of an FMU instance ([`PARAMETERS`]), the scenario they loaded
 /// and the log they opened.
 ///
 /// A clone (the FMU-state copies the layer keeps) shares the log: the log is the instance's
-/// own, not part of the FMU state.
+/// own, not part of the FMU state (nor are `log_file` and `run_id`).
 #[derive(Debug, Clone, Default)]
 pub struct RunSession {
     scenario_parameter: String,
     log_file: String,
+    run_id: String,
     resource_dir: Option<PathBuf>,
     loaded: Option<ScenarioFile>,
     log: SharedLog,
 }
 
 impl RunSession {
-    /// A session of an instance whose resources folder is `resource_dir`: both parameters
-    /// empty (the bundled scenario, no log), nothing loaded.
+    /// A session of an instance whose resources folder is `resource_dir`: every parameter
+    /// empty (the bundled scenario, no log, no run identifier), nothing loaded.
     #[must_use]
     pub fn new(resource_dir: Option<&Path>) -> Self {
         RunSession {
@@ -72,6 +132,39 @@ impl RunSession {
     /// Sets the `log_file` parameter (the log is created when initialization ends).
     pub fn set_log_file(&mut self, value: &str) {
         value.clone_into(&mut self.log_file);
+    }
+
+    /// The `run_id` parameter.
+    #[must_use]
+    pub fn run_id(&self) -> &str {
+        &self.run_id
+    }
+
+    /// The value of the session's parameter `index` ([`PARAMETERS`]).
+    ///
+    /// # Panics
+    /// `index` out of [`PARAMETERS`] (the FMU's variable table only makes valid ones).
+    #[must_use]
+    pub fn parameter(&self, index: usize) -> String {
+        match PARAMETERS[index].get(self) {
+            Value::String(v) => v,
+            other => unreachable!("the session's parameters are Strings, got {other:?}"),
+        }
+    }
+
+    /// Sets the session's parameter `index` ([`PARAMETERS`]) to `value`, or refuses it
+    /// (`parameter `run_id`: ...`). Returns the previous `scenario` when `index` is
+    /// [`SCENARIO`]: the FMU reads the scenario again during initialization and, when that
+    /// fails, restores it ([`RunSession::replace_scenario_parameter`]).
+    ///
+    /// # Errors
+    /// The parameter's refusal, naming it and the reason.
+    pub fn set_parameter(&mut self, index: usize, value: &str) -> Result<Option<String>, String> {
+        let previous = (index == SCENARIO).then(|| self.scenario_parameter.clone());
+        PARAMETERS[index]
+            .set(self, Value::String(value.to_owned()))
+            .map_err(|e| format!("parameter `{}`: {}", e.field, e.reason))?;
+        Ok(previous)
     }
 
     /// Reads the scenario the `scenario` parameter names (or the bundled one), hands it to
@@ -110,8 +203,8 @@ impl RunSession {
     }
 
     /// Creates the log `log_file` names (nothing when it is empty), writes the run
-    /// description (`header`, the `scenario` parameter, the loaded scenario's name and text)
-    /// and what `setup` writes (channels, messages at the start time), then hands the
+    /// description (`header`, the `scenario` parameter, `run_id`, the loaded scenario's name
+    /// and text, the session's parameters among the FMU's) and what `setup` writes (channels, messages at the start time), then hands the
     /// writer to its own thread. A log of an earlier initialization (after `fmi2Reset`) was
     /// finished by [`release`](Self::release).
     ///
@@ -131,16 +224,18 @@ impl RunSession {
             .loaded
             .as_ref()
             .ok_or_else(|| "no scenario is loaded".to_owned())?;
+        let mut parameters = header.parameters;
+        parameters.extend(crate::parameters::values_json(PARAMETERS, self));
         let info = RunInfo {
             unit: header.unit,
             guid: header.guid,
             version: header.version,
             scenario: &self.scenario_parameter,
             scenario_name: &loaded.scenario.name,
+            run_id: &self.run_id,
             start_time: header.start_time,
-            parameters: header.parameters,
+            parameters: serde_json::Value::Object(parameters),
             scenario_text: &loaded.text,
-            ..RunInfo::default()
         };
         self.log = SharedLog::open(&self.log_file, LogOptions::default(), &info, setup)
             .map_err(|e| format!("parameter `log_file`: {e}"))?;
@@ -205,7 +300,7 @@ mod tests {
             guid: "{0}",
             version: "0",
             start_time: 0.0,
-            parameters: serde_json::json!({}),
+            parameters: serde_json::Map::new(),
         };
         session.open_log(&logger, header, |_| Ok(())).unwrap();
         assert!(!session.log().is_active());
@@ -221,9 +316,65 @@ mod tests {
             guid: "{0}",
             version: "0",
             start_time: 0.0,
-            parameters: serde_json::json!({}),
+            parameters: serde_json::Map::new(),
         };
         let e = session.open_log(&Logger::silent("s"), header, |_| Ok(()));
         assert_eq!(e, Err("no scenario is loaded".to_owned()));
+    }
+
+    #[test]
+    fn the_session_parameters_are_strings_with_value_references_1_to_3() {
+        let names: Vec<&str> = PARAMETERS.iter().map(|p| p.name).collect();
+        assert_eq!(names, ["scenario", "log_file", "run_id"]);
+        assert_eq!(PARAMETERS[SCENARIO].name, "scenario");
+        let vrs: Vec<u32> = (0..PARAMETERS.len())
+            .map(crate::vr::session_parameter)
+            .collect();
+        assert_eq!(
+            vrs,
+            [crate::vr::SCENARIO, crate::vr::LOG_FILE, crate::vr::RUN_ID]
+        );
+        assert_eq!(vrs, [1, 2, 3]);
+        for p in PARAMETERS {
+            assert_eq!(p.type_name(), "String", "{}", p.name);
+            assert_eq!(
+                p.default_value(),
+                Value::String(String::new()),
+                "{}",
+                p.name
+            );
+        }
+    }
+
+    #[test]
+    fn setting_a_parameter_returns_the_previous_scenario_and_run_id_refuses_control_characters() {
+        let mut session = RunSession::new(None);
+        assert_eq!(
+            session.set_parameter(SCENARIO, "a.toml"),
+            Ok(Some(String::new()))
+        );
+        assert_eq!(
+            session.set_parameter(SCENARIO, "b.toml"),
+            Ok(Some("a.toml".to_owned()))
+        );
+        assert_eq!(session.scenario_parameter(), "b.toml");
+        assert_eq!(session.set_parameter(1, "/tmp/x.mcap"), Ok(None));
+        assert_eq!(session.log_file(), "/tmp/x.mcap");
+        assert_eq!(session.set_parameter(2, "2024-05-01 run 7 ✓"), Ok(None));
+        assert_eq!(session.run_id(), "2024-05-01 run 7 ✓");
+        assert_eq!(session.parameter(2), "2024-05-01 run 7 ✓");
+        let e = session.set_parameter(2, "a\nb").unwrap_err();
+        assert_eq!(
+            e,
+            "parameter `run_id`: must not contain control characters (it is one line of the log's run description), got \"a\\nb\" with U+000A"
+        );
+        assert_eq!(
+            session.run_id(),
+            "2024-05-01 run 7 ✓",
+            "the old value is kept"
+        );
+        let values = crate::parameters::values_json(PARAMETERS, &session);
+        assert_eq!(values["scenario"], "b.toml");
+        assert_eq!(values["run_id"], "2024-05-01 run 7 ✓");
     }
 }

@@ -226,6 +226,37 @@ pub fn assert_missing_scenario_file_is_named(exports: Exports, description: &Mod
     assert_last_message_contains(&fmu, missing);
 }
 
+/// `run_id` (value reference 3) is set and read with fmi2SetString/fmi2GetString, before
+/// and during initialization; one with a control character is refused naming the
+/// parameter and the reason, and the previous value is kept.
+pub fn assert_run_id_is_kept_and_checked(exports: Exports, description: &ModelDescription) {
+    let run_id = crate::vr::RUN_ID;
+    let fmu = instantiate(exports, description, "run_id");
+    assert_eq!(
+        fmu.set_string(run_id, "campaign 3 / run 12"),
+        Fmi2Status::Ok
+    );
+    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
+    assert_eq!(fmu.enter_init(), Fmi2Status::Ok, "{}", fmu.log_text());
+    assert_eq!(fmu.get_string(run_id), "campaign 3 / run 12");
+    assert_eq!(fmu.set_string(run_id, "a\tb"), Fmi2Status::Error);
+    assert_last_message_contains(
+        &fmu,
+        "parameter `run_id`: must not contain control characters",
+    );
+    let fmu = instantiate(exports, description, "run_id2");
+    assert_eq!(fmu.set_string(run_id, "line\nbreak"), Fmi2Status::Error);
+    assert_eq!(
+        fmu.setup(0.0, None),
+        Fmi2Status::Error,
+        "the instance is in error"
+    );
+    let fmu = instantiate(exports, description, "run_id3");
+    assert_eq!(fmu.setup(0.0, None), Fmi2Status::Ok);
+    assert_eq!(fmu.enter_init(), Fmi2Status::Ok, "{}", fmu.log_text());
+    assert_eq!(fmu.get_string(run_id), "", "empty by default");
+}
+
 /// The model-description tests of an FMU crate, on the `static` [`ModelDescription`]
 /// `$description` and the FMU's [`VariableTable`] `$table`: consistent, equal to the
 /// committed `modelDescription/<id>.xml`, its variable table in docs/interface.md, every

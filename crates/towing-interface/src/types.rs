@@ -6,6 +6,7 @@ use fmi2_slave::description::{
     BaseUnit, DefaultExperiment, DisplayUnit, LogCategory, ModelDescription, SimpleType,
     UnitDefinition, Variable, VariableKind,
 };
+use towing_model::registry::Enumeration;
 
 /// A Real type: one `SimpleType` and its unit's `UnitDefinition`. Every Real variable with
 /// a unit declares the type of its unit ([`ModelInfo::real_kind`]).
@@ -165,16 +166,26 @@ impl ModelInfo {
 
     /// The model description with `variables` in this order: units and Real types of
     /// [`REAL_TYPES`] and [`extra_types`](Self::extra_types), the Integer type
-    /// [`OBSTACLE_KIND_TYPE`], the standard log categories and `logEvents`, a default
-    /// experiment of 1200 s in steps of 0.1 s.
+    /// [`OBSTACLE_KIND_TYPE`], the Enumeration types of the parameters (`enumerations`,
+    /// [`crate::parameters::enumerations`]), the standard log categories and `logEvents`,
+    /// a default experiment of 1200 s in steps of 0.1 s.
     #[must_use]
-    pub fn model_description(&self, variables: Vec<Variable>) -> ModelDescription {
+    pub fn model_description(
+        &self,
+        variables: Vec<Variable>,
+        enumerations: &[&Enumeration],
+    ) -> ModelDescription {
         let mut type_definitions: Vec<SimpleType> =
             self.real_types().map(RealType::simple_type).collect();
         type_definitions.push(
             SimpleType::integer(OBSTACLE_KIND_TYPE, "ObstacleKind")
                 .with_integer_range(0, 2)
                 .with_description("0 none, 1 static circle, 2 vessel ellipse"),
+        );
+        type_definitions.extend(
+            enumerations
+                .iter()
+                .map(|e| crate::parameters::simple_type(e)),
         );
         let mut log_categories = LogCategory::standard();
         log_categories.push(LogCategory::new("logEvents", self.log_events));

@@ -3,7 +3,7 @@
 //!
 //! The measurements (vessel states, towline values, obstacle slots) are computed by the
 //! plant from the scenario at initialization (`initial="calculated"`, initial dependency on
-//! `scenario`); the commands (tug forces, tension commands) are the controller's outputs and
+//! the session's `scenario`, [`vr::SCENARIO`]); the commands (tug forces, tension commands) are the controller's outputs and
 //! hold their start value 0 until its first step (`initial="exact"`). Every input starts at
 //! 0. The descriptions say what the variable means to the FMU that declares it.
 
@@ -12,7 +12,7 @@ use crate::codec::{
     Tug, Vessel,
 };
 use crate::types::{real_kind, OBSTACLE_KIND_TYPE};
-use crate::VESSELS;
+use crate::{vr, VESSELS};
 use fmi2_slave::description::{Causality, Initial, Variability, Variable, VariableKind};
 
 /// Which end of a connection an FMU is for a group of variables.
@@ -155,33 +155,6 @@ pub fn parameter(name: &str, vr: u32, kind: VariableKind, description: &str) -> 
     }
 }
 
-/// The String parameter `scenario` ([`ContractVariable::Scenario`], start empty).
-#[must_use]
-pub fn scenario_parameter(description: &str) -> Variable {
-    parameter(
-        &ContractVariable::Scenario.name(),
-        ContractVariable::Scenario.encode(),
-        VariableKind::String {
-            start: Some(String::new()),
-        },
-        description,
-    )
-}
-
-/// The String parameter `log_file` ([`ContractVariable::LogFile`], start empty): the MCAP
-/// log of the unit (docs/logging.md), created when initialization ends; empty, no log.
-#[must_use]
-pub fn log_file_parameter() -> Variable {
-    parameter(
-        &ContractVariable::LogFile.name(),
-        ContractVariable::LogFile.encode(),
-        VariableKind::String {
-            start: Some(String::new()),
-        },
-        "Path of the MCAP log of this unit (docs/logging.md), created (replaced) at fmi2ExitInitializationMode and closed at fmi2Terminate; empty: no log",
-    )
-}
-
 /// An input (its start value is in `kind`).
 #[must_use]
 pub fn input(name: String, vr: u32, kind: VariableKind, description: String) -> Variable {
@@ -231,7 +204,7 @@ fn measurement(
             vr,
             real_kind(unit, None),
             description,
-            vec![ContractVariable::Scenario.encode()],
+            vec![vr::SCENARIO],
         ),
         Direction::Input => input(name, vr, real_kind(unit, Some(0.0)), description),
     }
@@ -391,7 +364,7 @@ pub fn obstacles(direction: Direction) -> Vec<Variable> {
                 kind_vr,
                 kind(None),
                 format!("obstacle slot {k}: 0 none (empty slot or target ship not yet active), 1 static circle, 2 vessel ellipse"),
-                vec![ContractVariable::Scenario.encode()],
+                vec![vr::SCENARIO],
             ),
             Direction::Input => input(
                 name,
@@ -446,10 +419,13 @@ mod tests {
             all.extend(towline(Towline::Towline2, d));
             all.extend(obstacles(d));
         }
-        all.push(scenario_parameter("scenario"));
-        all.push(log_file_parameter());
+        let session: Vec<&str> = crate::session::PARAMETERS.iter().map(|p| p.name).collect();
+        assert_eq!(session, ["scenario", "log_file", "run_id"]);
         for name in crate::contract_names() {
-            assert!(all.iter().any(|v| v.name == name), "{name}");
+            assert!(
+                all.iter().any(|v| v.name == name) || session.contains(&name.as_str()),
+                "{name}"
+            );
         }
     }
 }

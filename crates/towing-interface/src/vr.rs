@@ -6,19 +6,29 @@
 //!
 //! | range | what |
 //! |---|---|
-//! | 1 | `scenario` (String parameter) |
-//! | 2 | `log_file` (String parameter); other parameters are each FMU's own, below 100 |
+//! | 1, 2, 3 | the session's String parameters `scenario`, `log_file`, `run_id` ([`session_parameter`], [`crate::session::PARAMETERS`]) |
+//! | 10.. | each FMU's own parameters, `10 + index` ([`crate::parameters::parameter_vr`]), below 100 |
 //! | 100 + 10 vessel + c | vessel states (ship 100.., tug1 110.., tug2 120..; c: x, y, psi, u, v, r) |
 //! | 200 + 10 tug + c, 220 + line | commands: tug forces (tug1 200.., tug2 210..), tension commands |
 //! | 300 + 10 line + field | towline values (towline1 300.., towline2 310..) |
 //! | 1000 + 10 (k - 1) + j | obstacle slot k = 1..=8, field j |
 
+/// The session's String parameter `index` ([`crate::session::PARAMETERS`]): `1 + index`.
+#[must_use]
+pub const fn session_parameter(index: usize) -> u32 {
+    // Three session parameters: the cast is exact.
+    1 + index as u32
+}
+
 /// `scenario` (String parameter): path of the scenario file; empty = bundled paper scenario.
-pub const SCENARIO: u32 = 1;
+pub const SCENARIO: u32 = session_parameter(0);
 
 /// `log_file` (String parameter): path of the MCAP log (docs/logging.md); empty = no log.
-/// A String value reference, so it does not clash with an FMU's Integer parameter 2.
-pub const LOG_FILE: u32 = 2;
+pub const LOG_FILE: u32 = session_parameter(1);
+
+/// `run_id` (String parameter): the run's identifier, written into the log's run
+/// description; empty = none.
+pub const RUN_ID: u32 = session_parameter(2);
 
 /// Vessel state: vessel 0 ship, 1 tug1, 2 tug2; component 0..6 = x, y, psi, u, v, r.
 pub const fn vessel_state(vessel: u32, component: u32) -> u32 {

@@ -145,15 +145,15 @@ pub mod metadata_keys {
     pub const SCENARIO: &str = "scenario";
     /// The scenario's name.
     pub const SCENARIO_NAME: &str = "scenario_name";
+    /// The run's identifier (the FMUs' `run_id` parameter), the same in every unit's log;
+    /// absent when none was given and from logs written before it existed (read as empty).
+    pub const RUN_ID: &str = "run_id";
     /// Always [`super::EPOCH`].
     pub const EPOCH: &str = "epoch";
     /// Start time of the run (simulation time, s).
     pub const START_TIME: &str = "start_time";
     /// JSON object of every parameter's value.
     pub const PARAMETERS: &str = "parameters";
-    /// Identifier of the run, the same in every unit's log; absent when the run has none
-    /// ([`crate::RunInfo::run_id`] empty).
-    pub const RUN_ID: &str = "run_id";
 }
 /// Value of the `epoch` metadata key.
 pub const EPOCH: &str = "simulation time 0 s";

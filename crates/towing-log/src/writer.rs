@@ -520,16 +520,16 @@ pub struct RunInfo<'a> {
     pub scenario: &'a str,
     /// The scenario's name.
     pub scenario_name: &'a str,
+    /// The run's identifier (the FMUs' `run_id` parameter; empty: none given): the same in
+    /// the plant's and the controller's log of one run. Written as the metadata key
+    /// `run_id` when not empty; the analyzer refuses to put together logs whose ids differ.
+    pub run_id: &'a str,
     /// Start time of the run (simulation time, s).
     pub start_time: f64,
     /// Every parameter's value, a JSON object.
     pub parameters: serde_json::Value,
     /// The scenario text used (attached as `scenario.toml`).
     pub scenario_text: &'a str,
-    /// An identifier of the run shared by every unit's log (empty by default: none). When
-    /// set, it is written as the metadata key `run_id`, and the analyzer refuses to put
-    /// together logs whose ids differ (docs/logging.md).
-    pub run_id: &'a str,
 }
 
 impl LogWriter {
@@ -550,10 +550,10 @@ impl LogWriter {
             (k::VERSION, info.version.to_owned()),
             (k::SCENARIO, scenario.to_owned()),
             (k::SCENARIO_NAME, info.scenario_name.to_owned()),
+            (k::RUN_ID, info.run_id.to_owned()),
             (k::EPOCH, t::EPOCH.to_owned()),
             (k::START_TIME, format!("{}", info.start_time)),
             (k::PARAMETERS, info.parameters.to_string()),
-            (k::RUN_ID, info.run_id.to_owned()),
         ]
         .into_iter()
         .filter(|(key, value)| *key != k::RUN_ID || !value.is_empty())

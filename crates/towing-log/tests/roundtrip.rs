@@ -489,23 +489,23 @@ fn run_metadata_and_the_scenario_attachment() {
         version: "0.1.0",
         scenario: "",
         scenario_name: "paper",
+        run_id: "run 42",
         start_time: 0.0,
         parameters: serde_json::json!({"hull_model": 0, "scenario": ""}),
         scenario_text: "name = \"paper\"\n",
-        run_id: "",
     })
     .unwrap();
     w.finish().unwrap();
     let bytes = std::fs::read(&path).unwrap();
     let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
     let run = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).unwrap();
-    assert!(!run.metadata.contains_key("run_id"), "no run_id when empty");
     assert_eq!(run.name, "run");
     let m = &run.metadata;
     assert_eq!(m["unit"], "TowingPlant");
     assert_eq!(m["scenario"], topics::BUNDLED_SCENARIO_LABEL);
     assert_eq!(m["epoch"], "simulation time 0 s");
     assert_eq!(m["start_time"], "0");
+    assert_eq!(m["run_id"], "run 42");
     let params: serde_json::Value = serde_json::from_str(&m["parameters"]).unwrap();
     assert_eq!(params["hull_model"], 0);
     for key in ["guid", "version", "scenario_name"] {
@@ -595,6 +595,17 @@ fn a_run_id_is_written_in_the_run_metadata() {
     assert_eq!(
         run.metadata[topics::metadata_keys::RUN_ID],
         "campaign-7/run-0042"
+    );
+    let empty = dir.path().join("empty.mcap");
+    let mut w = LogWriter::create(&empty, LogOptions::default()).unwrap();
+    w.write_run(&towing_log::RunInfo::default()).unwrap();
+    w.finish().unwrap();
+    let bytes = std::fs::read(&empty).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let run = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).unwrap();
+    assert!(
+        !run.metadata.contains_key("run_id"),
+        "no run_id when none given"
     );
 }
 

@@ -134,11 +134,12 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use crate::registry::{Enumeration, Item};
 use crate::vessel::{Damping, ParamError, VesselData};
 
-/// Which built-in hull model the world uses: the plant parameter that selects the
-/// damping law (scenario `[simulation] hull_model`, plant FMU parameter
-/// `hull_model`). [`HullModel::build`] makes the [`HullDynamics`] of one vessel.
+/// Which built-in hull model the world uses: the damping law (scenario `[simulation]
+/// hull_model`, the plant's parameter `model.hull`, the controller's `mpc.hull_model`).
+/// [`HullModel::build`] makes the [`HullDynamics`] of one vessel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum HullModel {
     /// [`LinearDampingHull`]: constant `D = -[[X_u, 0, 0], [0, Y_v, Y_r], [0, N_v,
@@ -154,6 +155,46 @@ pub enum HullModel {
 }
 
 impl HullModel {
+    /// The FMI Enumeration type `HullModel` of the parameters that choose a hull model
+    /// (FMI 2.0 section 2.2.3): 1 `linear_damping`, 2 `nonlinear_damping` (the scenario
+    /// format's names; the codes the masters have always used).
+    pub const ENUMERATION: Enumeration = Enumeration {
+        name: "HullModel",
+        description: "Hull damping model",
+        items: &[
+            Item {
+                name: "linear_damping",
+                value: 1,
+                description: "constant D from the linear derivatives, the paper's eq. (1)",
+            },
+            Item {
+                name: "nonlinear_damping",
+                value: 2,
+                description: "the full D(nu) of Skjetne et al. (2004) for CyberShip II",
+            },
+        ],
+    };
+
+    /// The value of its item of [`HullModel::ENUMERATION`].
+    #[must_use]
+    pub const fn code(self) -> i32 {
+        match self {
+            HullModel::LinearDamping => 1,
+            HullModel::NonlinearDamping => 2,
+        }
+    }
+
+    /// The hull model of an item's value of [`HullModel::ENUMERATION`]; `None` for
+    /// another value.
+    #[must_use]
+    pub const fn from_code(code: i32) -> Option<HullModel> {
+        match code {
+            1 => Some(HullModel::LinearDamping),
+            2 => Some(HullModel::NonlinearDamping),
+            _ => None,
+        }
+    }
+
     /// Builds this model's hull for one vessel; validates the data
     /// ([`VesselData::validate`]) first. The only allocation is the box.
     pub fn build(self, data: &VesselData) -> Result<Box<dyn HullDynamics>, ParamError> {
@@ -799,5 +840,21 @@ mod tests {
                 prop_assert!(hull.power_balance(&nu, &Vector3::zeros()) < 0.0, "{name}");
             }
         }
+    }
+
+    #[test]
+    fn hull_models_are_the_items_of_their_enumeration() {
+        let items = HullModel::ENUMERATION.items;
+        assert_eq!(items.len(), 2);
+        for (item, model) in items
+            .iter()
+            .zip([HullModel::LinearDamping, HullModel::NonlinearDamping])
+        {
+            assert_eq!(model.code(), item.value, "{}", item.name);
+            assert_eq!(HullModel::from_code(item.value), Some(model));
+        }
+        assert_eq!(items[0].name, "linear_damping");
+        assert_eq!(HullModel::from_code(0), None);
+        assert_eq!(HullModel::from_code(3), None);
     }
 }

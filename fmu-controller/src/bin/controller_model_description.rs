@@ -4,6 +4,6 @@
 fn main() -> std::process::ExitCode {
     towing_interface::model_description_main(
         &towing_controller::variables::DESCRIPTION,
-        &towing_model::registry::markdown(towing_control::PARAMETERS),
+        &towing_interface::parameters::markdown(towing_control::PARAMETERS),
     )
 }

@@ -4,6 +4,6 @@
 fn main() -> std::process::ExitCode {
     towing_interface::model_description_main(
         &towing_plant::variables::DESCRIPTION,
-        &towing_model::registry::markdown(towing_plant::params::PARAMETERS),
+        &towing_interface::parameters::markdown(towing_plant::params::PARAMETERS),
     )
 }

@@ -783,3 +783,187 @@ fn with_declared_type_sets_real_and_integer() {
         None
     );
 }
+
+// ---- Enumerations (FMI 2.0 sections 2.2.3 and 2.2.7) ---------------------------------
+
+/// `typed_sample()` with the Enumeration type `Method` (1 `euler`, 2 `heun`) and the
+/// tunable Enumeration parameter `method` (Integer/Enumeration value reference 7, start 2).
+fn enum_sample() -> ModelDescription {
+    let mut md = typed_sample();
+    md.type_definitions.push(
+        SimpleType::enumeration(
+            "Method",
+            "",
+            vec![
+                EnumerationItem::new("euler", 1, "explicit Euler"),
+                EnumerationItem::new("heun", 2, "Heun's <method>"),
+            ],
+        )
+        .with_description("integration method"),
+    );
+    md.variables.push(Variable::enumeration_parameter(
+        "method",
+        7,
+        "Method",
+        2,
+        Variability::Tunable,
+        "integration method",
+    ));
+    md
+}
+
+#[test]
+fn enumeration_types_and_variables_are_written_as_fmi_2_0_says() {
+    let md = enum_sample();
+    assert_eq!(errors_of(&md), Vec::<String>::new());
+    let x = md.to_xml();
+    let ty = "    <SimpleType name=\"Method\" description=\"integration method\">\n      <Enumeration>\n        <Item name=\"euler\" value=\"1\" description=\"explicit Euler\"/>\n        <Item name=\"heun\" value=\"2\" description=\"Heun&apos;s &lt;method&gt;\"/>\n      </Enumeration>\n    </SimpleType>\n  </TypeDefinitions>\n";
+    assert!(x.contains(ty), "{x}");
+    assert!(
+        x.contains("<ScalarVariable name=\"method\" valueReference=\"7\" description=\"integration method\" causality=\"parameter\" variability=\"tunable\" initial=\"exact\">\n      <Enumeration declaredType=\"Method\" start=\"2\"/>\n    </ScalarVariable>"),
+        "{x}"
+    );
+    let quantity = SimpleType::enumeration("Q", "Choice", vec![EnumerationItem::new("a", 1, "")]);
+    let mut md = enum_sample();
+    md.type_definitions.push(quantity);
+    assert!(md
+        .to_xml()
+        .contains("<Enumeration quantity=\"Choice\">\n        <Item name=\"a\" value=\"1\"/>"));
+}
+
+#[test]
+fn enumeration_variables_are_accessed_as_integers() {
+    let md = enum_sample();
+    let v = md.find(ValueType::Integer, 7).unwrap();
+    assert_eq!(v.name, "method");
+    assert_eq!(v.value_type(), ValueType::Integer);
+    assert_eq!(v.kind.element(), "Enumeration");
+    assert_eq!(v.kind.declared_type(), Some("Method"));
+    assert!(md.find(ValueType::Real, 7).is_none());
+    // Integer and Enumeration share one value-reference numbering (FMI 2.0 section 2.2.7).
+    let mut md = enum_sample();
+    md.variables.last_mut().unwrap().value_reference = 1;
+    assert_error(
+        &md,
+        "'method'",
+        "Integer value reference 1 is already used by 'n'",
+    );
+}
+
+#[test]
+fn rule_enumeration_declared_type_exists_and_is_an_enumeration() {
+    let mut md = enum_sample();
+    md.variables.last_mut().unwrap().kind = VariableKind::Enumeration {
+        declared_type: "Scheme".into(),
+        start: Some(1),
+    };
+    assert_error(
+        &md,
+        "'method'",
+        "declaredType 'Scheme' is not defined in TypeDefinitions",
+    );
+    let mut md = enum_sample();
+    md.variables.last_mut().unwrap().kind = VariableKind::Enumeration {
+        declared_type: "Count".into(),
+        start: Some(1),
+    };
+    assert_error(
+        &md,
+        "'method'",
+        "declaredType 'Count' is a Integer type but the variable is Enumeration",
+    );
+    // An Integer variable cannot declare an Enumeration type either.
+    let mut md = enum_sample();
+    md.variables[3] = md.variables[3].clone().with_declared_type("Method");
+    assert_error(
+        &md,
+        "'n'",
+        "declaredType 'Method' is a Enumeration type but the variable is Integer",
+    );
+}
+
+#[test]
+fn rule_enumeration_start_is_one_of_the_items() {
+    for bad in [0, 3, -1] {
+        let mut md = enum_sample();
+        md.variables.last_mut().unwrap().kind = VariableKind::Enumeration {
+            declared_type: "Method".into(),
+            start: Some(bad),
+        };
+        assert_error(
+            &md,
+            "'method'",
+            &format!("start {bad} is not an item of its declaredType 'Method' (1 euler, 2 heun)"),
+        );
+    }
+    // A parameter needs its start, an Enumeration one too.
+    let mut md = enum_sample();
+    md.variables.last_mut().unwrap().kind = VariableKind::Enumeration {
+        declared_type: "Method".into(),
+        start: None,
+    };
+    assert_error(&md, "'method'", "a start value is required");
+}
+
+#[test]
+fn rule_enumeration_items_are_present_named_and_unique() {
+    let with_items = |items: Vec<EnumerationItem>| {
+        let mut md = enum_sample();
+        md.type_definitions
+            .push(SimpleType::enumeration("E", "", items));
+        md
+    };
+    assert_error(
+        &with_items(vec![]),
+        "type 'E'",
+        "an Enumeration needs at least one Item",
+    );
+    assert_error(
+        &with_items(vec![EnumerationItem::new("", 1, "")]),
+        "type 'E'",
+        "item of value 1 has an empty name",
+    );
+    assert_error(
+        &with_items(vec![
+            EnumerationItem::new("a", 1, ""),
+            EnumerationItem::new("a", 2, ""),
+        ]),
+        "type 'E'",
+        "item name 'a' is used twice",
+    );
+    assert_error(
+        &with_items(vec![
+            EnumerationItem::new("a", 1, ""),
+            EnumerationItem::new("b", 1, ""),
+        ]),
+        "type 'E'",
+        "items 'a' and 'b' have the same value 1",
+    );
+    assert_error(
+        &with_items(vec![EnumerationItem::new("a", 1, "bell\u{7}")]),
+        "description of item 'a' of type 'E'",
+        "control character",
+    );
+    // Values need not be 1..n (FMI 2.0 gives each item its value).
+    assert_eq!(
+        errors_of(&with_items(vec![
+            EnumerationItem::new("minus", -1, ""),
+            EnumerationItem::new("ten", 10, ""),
+        ])),
+        Vec::<String>::new()
+    );
+}
+
+#[test]
+fn with_declared_type_renames_an_enumerations_type() {
+    let v = Variable::enumeration_parameter("m", 1, "A", 1, Variability::Fixed, "")
+        .with_declared_type("B");
+    assert_eq!(v.kind.declared_type(), Some("B"));
+    assert_eq!(items_text(&[EnumerationItem::new("x", 4, "")]), "4 x");
+}
+
+#[test]
+#[should_panic(expected = "with_integer_range on non-Integer type 'Method'")]
+fn integer_range_on_an_enumeration_type_panics_with_the_name() {
+    let _ = SimpleType::enumeration("Method", "", vec![]).with_integer_range(0, 1);
+}

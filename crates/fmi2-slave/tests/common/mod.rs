@@ -12,9 +12,9 @@ use std::sync::LazyLock;
 
 use fmi2_slave::testing::{Exports, Fmu, Msg};
 use fmi2_slave::{
-    BaseUnit, Causality, DefaultExperiment, Fmi2Model, Initial, InstanceContext, LogCategory,
-    Logger, ModelDescription, StepContext, StepOutcome, UnitDefinition, Variability, Variable,
-    VariableKind,
+    BaseUnit, Causality, DefaultExperiment, EnumerationItem, Fmi2Model, Initial, InstanceContext,
+    LogCategory, Logger, ModelDescription, SimpleType, StepContext, StepOutcome, UnitDefinition,
+    Variability, Variable, VariableKind,
 };
 
 // ---- value references ------------------------------------------------------------------
@@ -27,6 +27,11 @@ pub const I_SUBSTEPS: u32 = 1;
 pub const I_STEPS: u32 = 2;
 pub const I_FAULT: u32 = 13;
 pub const I_VERSION: u32 = 4;
+/// The Enumeration parameter `method` (type `Method`: 1 euler, 2 heun), accessed as an
+/// Integer (FMI 2.0 section 2.1.7).
+pub const E_METHOD: u32 = 6;
+pub const METHOD_EULER: i32 = 1;
+pub const METHOD_HEUN: i32 = 2;
 pub const B_ENABLED: u32 = 1;
 pub const B_PANIC_NOW: u32 = 2;
 pub const S_LABEL: u32 = 1;
@@ -65,7 +70,14 @@ pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(|| {
                 },
             ),
         ],
-        type_definitions: vec![],
+        type_definitions: vec![SimpleType::enumeration(
+            "Method",
+            "",
+            vec![
+                EnumerationItem::new("euler", METHOD_EULER, "explicit Euler substeps"),
+                EnumerationItem::new("heun", METHOD_HEUN, "Heun substeps (explicit trapezoidal)"),
+            ],
+        )],
         log_categories,
         default_experiment: DefaultExperiment {
             start_time: 0.0,
@@ -119,6 +131,14 @@ pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(|| {
             ),
             Variable::boolean_input("panic_now", B_PANIC_NOW, false, "panics when set to true"),
             Variable::string_parameter("label", S_LABEL, "lag", "free text"),
+            Variable::enumeration_parameter(
+                "method",
+                E_METHOD,
+                "Method",
+                METHOD_EULER,
+                Variability::Tunable,
+                "integration method",
+            ),
         ],
         can_get_and_set_fmu_state: true,
         can_serialize_fmu_state: true,
@@ -153,6 +173,7 @@ pub struct LagModel<const BROKEN: bool> {
     fault_mode: i32,
     enabled: bool,
     label: String,
+    method: i32,
     resource_dir: Option<PathBuf>,
 }
 
@@ -183,6 +204,7 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
             fault_mode: 0,
             enabled: true,
             label: "lag".into(),
+            method: METHOD_EULER,
             resource_dir: ctx.resource_dir.map(PathBuf::from),
         })
     }
@@ -228,6 +250,7 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
             I_STEPS => self.steps,
             I_FAULT => self.fault_mode,
             I_VERSION => 7,
+            E_METHOD => self.method,
             _ => return Err(unknown("Integer", vr)),
         })
     }
@@ -237,6 +260,12 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
             I_SUBSTEPS if value < 1 => return Err(format!("substeps must be >= 1, got {value}")),
             I_SUBSTEPS => self.substeps = value,
             I_FAULT => self.fault_mode = value,
+            E_METHOD if value == METHOD_EULER || value == METHOD_HEUN => self.method = value,
+            E_METHOD => {
+                return Err(format!(
+                    "method must be one of 1 euler, 2 heun, got {value}"
+                ))
+            }
             _ => unreachable!(),
         }
         Ok(())
@@ -289,8 +318,14 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
         );
         if self.enabled {
             let dt = step.step_size / f64::from(self.substeps);
+            let slope = |y: f64| (self.u - y) / self.t_const;
             for _ in 0..self.substeps {
-                self.y += dt * (self.u - self.y) / self.t_const;
+                self.y += if self.method == METHOD_HEUN {
+                    let predicted = self.y + dt * slope(self.y);
+                    0.5 * dt * (slope(self.y) + slope(predicted))
+                } else {
+                    dt * slope(self.y)
+                };
             }
         }
         self.steps += 1;
@@ -310,7 +345,7 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
         for x in [self.u, self.y, self.t_const, self.y0] {
             out.extend_from_slice(&x.to_le_bytes());
         }
-        for i in [self.substeps, self.steps, self.fault_mode] {
+        for i in [self.substeps, self.steps, self.fault_mode, self.method] {
             out.extend_from_slice(&i.to_le_bytes());
         }
         out.push(u8::from(self.enabled));
@@ -319,13 +354,13 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
     }
 
     fn deserialize_state(&mut self, _log: &Logger, b: &[u8]) -> Result<(), String> {
-        if b.first() != Some(&1) || b.len() < 1 + 32 + 12 + 1 + 4 {
+        if b.first() != Some(&1) || b.len() < 1 + 32 + 16 + 1 + 4 {
             return Err("Lag state: bad version or too short".into());
         }
         let f = |i: usize| f64::from_le_bytes(b[1 + 8 * i..9 + 8 * i].try_into().unwrap());
         let n = |i: usize| i32::from_le_bytes(b[33 + 4 * i..37 + 4 * i].try_into().unwrap());
-        let len = u32::from_le_bytes(b[46..50].try_into().unwrap()) as usize;
-        if b.len() != 50 + len {
+        let len = u32::from_le_bytes(b[50..54].try_into().unwrap()) as usize;
+        if b.len() != 54 + len {
             return Err("Lag state: length mismatch".into());
         }
         *self = LagModel {
@@ -336,8 +371,9 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
             substeps: n(0),
             steps: n(1),
             fault_mode: n(2),
-            enabled: b[45] != 0,
-            label: String::from_utf8(b[50..].to_vec()).map_err(|e| e.to_string())?,
+            method: n(3),
+            enabled: b[49] != 0,
+            label: String::from_utf8(b[54..].to_vec()).map_err(|e| e.to_string())?,
             resource_dir: self.resource_dir.clone(),
         };
         Ok(())
