@@ -36,6 +36,7 @@ use towing_mpc::{
 
 use crate::config::{Architecture, ControllerConfig, InnerLoopParams};
 use crate::error::{ConfigError, MeasurementError};
+use crate::mpc_input::MpcInput;
 
 /// What the controller reads every step: the plant's outputs.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -208,6 +209,8 @@ pub struct Controller {
     /// Per obstacle slot: the ship's heading when an encounter began in which
     /// the tow may not turn to port ([`TrackingParams::port_turn_margin`]).
     port_turn_anchor: [Option<f64>; MAX_OBSTACLES],
+    /// A copy of the last sample's MPC input ([`Controller::last_mpc_input`]).
+    last_input: Option<MpcInput>,
 }
 
 fn mass_matrix(d: &VesselData) -> [[f64; 3]; 3] {
@@ -292,6 +295,7 @@ impl Controller {
                 radius: 1.0,
             }; MAX_OBSTACLES],
             port_turn_anchor: [None; MAX_OBSTACLES],
+            last_input: None,
         })
     }
 
@@ -311,6 +315,15 @@ impl Controller {
     #[must_use]
     pub fn applied(&self) -> &AppliedCommand {
         &self.applied
+    }
+
+    /// The input the MPC was given in the last control sample (`None` before
+    /// the first): the states, previous command, reference, obstacles and
+    /// heading floor of [`towing_mpc::SampleInput`], owned. Read-only; for
+    /// replaying the same problem elsewhere ([`MpcInput`]).
+    #[must_use]
+    pub fn last_mpc_input(&self) -> Option<&MpcInput> {
+        self.last_input.as_ref()
     }
 
     /// One control sample (module docs).
@@ -375,6 +388,7 @@ impl Controller {
             obstacles: &self.mpc_obstacles[..n_obstacles],
             heading_floor,
         };
+        self.last_input = Some(MpcInput::of(&input));
         let report = self.solver.solve(&input);
         let ship_plan = *self.solver.ship_plan();
         let tug_plans = [*self.solver.tug_plan(0), *self.solver.tug_plan(1)];

@@ -23,9 +23,11 @@
 pub mod config;
 pub mod controller;
 pub mod error;
+pub mod mpc_input;
 
 pub use config::{
     Architecture, AvoidanceScheme, ControllerConfig, InnerLoopParams, TrackingParams,
 };
 pub use controller::{Command, Controller, Fallback, Measurement, Prediction, SampleReport};
 pub use error::{ConfigError, MeasurementError};
+pub use mpc_input::MpcInput;
