@@ -164,8 +164,7 @@ class Sequence:
             last = (n, x, [float(v) for v in ca.vertsplit(sol["lam_x"])],
                     [float(v) for v in ca.vertsplit(sol["lam_g"])]) if finite else None
             merit = float(self.merits[n](x[:nlp.n_u], p)[0]) if finite else None
-            out.append({"time": sample["time"], "time_s": spent, "ipopt_wall_s": stats.get("t_wall_total"),
-                        "iterations": stats["iter_count"],
+            out.append({"time": sample["time"], "time_s": spent, "iterations": stats["iter_count"],
                         "status": stats["return_status"], "success": bool(stats["success"]),
                         "merit_python": merit, "plan": cn.plan_dict(x[:nlp.n_u], H) if finite else None,
                         "violation": violation(nlp, x[:nlp.n_u], lbx, ubx) if finite else None})
@@ -205,7 +204,6 @@ def solve(args) -> None:
     result = runs[0]
     for k, r in enumerate(result):
         r["times_s"] = [run[k]["time_s"] for run in runs]
-        r["ipopt_wall_s"] = [run[k]["ipopt_wall_s"] for run in runs]
         del r["time_s"]
     if args.ours:
         ours = read(args.ours)["samples"]

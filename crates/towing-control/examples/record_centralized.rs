@@ -26,7 +26,7 @@
 //!   the loop: `shift()` after a sample, `reset()` where the loop fell back), each
 //!   `solve_sample` timed alone (`Instant` around the call), `--repeats` times
 //!   over the whole window (a fresh instance each time): per sample the times,
-//!   SCP iterations, the merit, its breakdown and the final plan.
+//!   SCP iterations, the merit, its breakdown, the last SCP step and the final plan.
 //!
 //! `evaluate` rebuilds the same problem (refusing a `problem` section that this
 //! build would not write) and evaluates other solvers' plans (`PLANS.json`:
@@ -49,7 +49,8 @@ use towing_control::{
 };
 use towing_model::{HullModel, Scenario, VesselData, World, WorldInputs};
 use towing_mpc::{
-    AppliedCommand, Centralized, CostBreakdown, Obstacle, SampleInput, ShipInput, TugInput, HORIZON,
+    AppliedCommand, Centralized, CostBreakdown, Obstacle, SampleInput, ScpReport, ShipInput,
+    TugInput, HORIZON,
 };
 
 /// Communication step of the loop (s), as the FMU masters use.
@@ -218,6 +219,7 @@ struct Replayed {
     failed: bool,
     merit: f64,
     breakdown: CostBreakdown,
+    last_step: ScpReport,
     ship: [ShipInput; HORIZON],
     tugs: [[TugInput; HORIZON]; 2],
 }
@@ -249,6 +251,7 @@ fn replay(config: &ControllerConfig, samples: &[Recorded], repeats: usize) -> Re
                     failed: r.failed,
                     merit: r.cost,
                     breakdown: r.breakdown,
+                    last_step: r.last_step,
                     ship,
                     tugs,
                 });
@@ -301,6 +304,7 @@ fn record(o: &RecordOptions) -> Res<()> {
             "merit": r.merit,
             "merit_evaluated": merit(&evaluated, &config),
             "breakdown": breakdown_json(&r.breakdown),
+            "last_step": step_json(&r.last_step),
             "plan": plan_json(&r.ship, &r.tugs),
             "first_move_as_in_loop": same,
         }));
@@ -456,6 +460,13 @@ fn sample_json(s: &Recorded) -> Value {
 
 fn plan_json(ship: &[ShipInput; HORIZON], tugs: &[[TugInput; HORIZON]; 2]) -> Value {
     json!({"ship": ship, "tugs": tugs})
+}
+
+/// The last SCP step of a sample (why it stopped).
+fn step_json(s: &ScpReport) -> Value {
+    json!({"qp": format!("{:?}", s.qp), "accepted": s.accepted, "cost_before": s.cost_before,
+           "cost_after": s.cost_after, "predicted_decrease": s.predicted_decrease,
+           "ratio": s.ratio, "radius": s.radius, "qp_iterations": s.qp_iterations})
 }
 
 fn breakdown_json(b: &CostBreakdown) -> Value {
