@@ -12,8 +12,8 @@ scheme I: target A's crossing given way to, the heading floor on, four obstacles
   because of the 1e4 clearance penalty), which leaves about 1e-5 of the merit (measured:
   3.9e-5 at t = 968 s, 9e-7 with tol = 1e-10 unscaled); two local solvers on the same
   problem from the same warm start land within 1e-4 of each other, while a different
-  problem (a term, weight or bound off) moves the merit by far more. Measured here: about
-  1e-7.
+  problem (a term, weight or bound off) moves the merit by far more. Measured here: at most
+  4e-7.
 
 No skipping: casadi is in masters/requirements.txt, which `cargo xtask test` installs.
 """
