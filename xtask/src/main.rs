@@ -10,6 +10,8 @@
 //! cargo xtask reproduce           the paper's six runs and docs/RESULTS.md
 //! cargo xtask campaign FILE --out DIR [--workers N] [--scheduler ADDRESS] [--resume]
 //!                                 many runs on Dask, judged by the analyzer (docs/campaigns.md)
+//! cargo xtask bench-baseline [--from S] [--to S] [--samples N] [--scheme N] [--repeats N]
+//!                                 CasADi + IPOPT beside the centralized MPC (docs/benchmarks.md)
 //! ```
 //!
 //! Every step prints what it does; a failing step names itself and the reason.
@@ -19,6 +21,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
+mod baseline;
 mod campaign;
 mod fmu;
 mod python;
@@ -169,7 +172,12 @@ commands:
   campaign FILE --out DIR [--workers N] [--scheduler ADDRESS] [--resume]
                       the campaign file's runs (scenarios x parameter values) on Dask, each judged
                       by the analyzer's verdict: DIR/summary.json, runs.parquet, report.html
-                      (docs/campaigns.md)";
+                      (docs/campaigns.md)
+  bench-baseline [--from S] [--to S] [--samples N] [--scheme 1|2|3] [--repeats N]
+                 [--ipopt KEY=VALUE] [--out DIR]
+                      the centralized MPC's problems of the paper scenario's closed loop (default
+                      0-1200 s, scheme I) solved by ours and by CasADi + IPOPT; one table of solve
+                      times and merits (out/bench-baseline/, docs/benchmarks.md)";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -182,6 +190,7 @@ fn main() -> ExitCode {
         Some("demo") => runs::demo(),
         Some("reproduce") => runs::reproduce(),
         Some("campaign") => campaign::campaign(&args[1..]),
+        Some("bench-baseline") => baseline::bench_baseline(&args[1..]),
         Some("-h" | "--help" | "help") => {
             progress(USAGE);
             Ok(())

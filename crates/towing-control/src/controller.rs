@@ -39,6 +39,7 @@ use towing_mpc::{
 
 use crate::config::{Architecture, ControllerConfig, InnerLoopParams};
 use crate::error::{ConfigError, MeasurementError};
+use crate::mpc_input::MpcInput;
 
 /// What the controller reads every step: the plant's outputs.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -273,6 +274,8 @@ pub struct Controller {
     /// the tow may not turn to port ([`TrackingParams::port_turn_margin`]).
     port_turn_anchor: [Option<f64>; MAX_OBSTACLES],
     clock: Clock,
+    /// A copy of the last sample's MPC input ([`Controller::last_mpc_input`]).
+    last_input: Option<MpcInput>,
 }
 
 fn mass_matrix(d: &VesselData) -> [[f64; 3]; 3] {
@@ -298,13 +301,7 @@ impl Controller {
             GuidanceParams::new(config.guidance())
                 .map_err(|e| ConfigError::new("guidance", e.to_string()))?,
         );
-        let mut ship_params = config.tuning.ship;
-        let mut tug_params = config.tuning.tug;
-        if !config.tuning.scheme.distance_cost() {
-            ship_params.weight_distance = 0.0;
-            tug_params.weight_distance = 0.0;
-        }
-        let solver = build_optimizer(&config, ship_params, tug_params)?;
+        let solver = build_optimizer(&config)?;
         let s = &config.scenario;
         let inner_k = std::array::from_fn(|i| {
             let m = mass_matrix(&s.tug_data[i]);
@@ -312,7 +309,7 @@ impl Controller {
         });
         let thrust_limit = std::array::from_fn(|i| {
             let d = &s.tug_data[i];
-            let l = tug_params.thrust_limit;
+            let l = config.tuning.tug.thrust_limit;
             [
                 l[0].min(d.max_surge_force),
                 l[1].min(d.max_sway_force),
@@ -348,6 +345,7 @@ impl Controller {
                 sample_ns: ((sample_time * 1e9).round() as i64).max(1),
                 ..Clock::default()
             },
+            last_input: None,
         })
     }
 
@@ -369,6 +367,15 @@ impl Controller {
         &self.applied
     }
 
+    /// The input the MPC was given in the last control sample (`None` before
+    /// the first): the states, previous command, reference, obstacles and
+    /// heading floor of [`towing_mpc::SampleInput`], owned. Read-only; for
+    /// replaying the same problem elsewhere ([`MpcInput`]).
+    #[must_use]
+    pub fn last_mpc_input(&self) -> Option<&MpcInput> {
+        self.last_input.as_ref()
+    }
+
     /// One control sample (module docs).
     ///
     /// # Errors
@@ -386,6 +393,7 @@ impl Controller {
             obstacles: &self.mpc_obstacles[..n_obstacles],
             heading_floor: guided.heading_floor,
         };
+        self.last_input = Some(MpcInput::of(&input));
         let budget_s = self.config.tuning.sample_time_budget;
         let budget = Budget::from(
             start,
@@ -827,47 +835,74 @@ fn mpc_obstacle(o: &ObstacleSlot, sample_time: f64) -> Obstacle {
     }
 }
 
+/// The ship's and the tugs' MPC parameters a [`Controller`] of `config` uses: the
+/// tuning's, with the distance weights zeroed when the scheme has no distance cost
+/// (scheme II).
+#[must_use]
+pub fn mpc_params(
+    config: &ControllerConfig,
+) -> (towing_mpc::ShipMpcParams, towing_mpc::TugMpcParams) {
+    let (mut ship, mut tug) = (config.tuning.ship, config.tuning.tug);
+    if !config.tuning.scheme.distance_cost() {
+        ship.weight_distance = 0.0;
+        tug.weight_distance = 0.0;
+    }
+    (ship, tug)
+}
+
+fn mpc_error(architecture: Architecture) -> impl Fn(AdmmBuildError) -> ConfigError {
+    move |source| ConfigError::Mpc {
+        architecture: match architecture {
+            Architecture::Distributed => "distributed",
+            Architecture::Centralized => "centralized",
+        },
+        source,
+    }
+}
+
+/// A fresh centralized MPC with exactly the parameters and prediction models a
+/// [`Controller`] of `config` would use if its architecture were centralized: for
+/// tools that solve the controller's recorded problems again outside the loop
+/// ([`Controller::last_mpc_input`], the side-by-side baseline).
+///
+/// # Errors
+/// As [`Controller::new`] for the MPC's models and parameters.
+pub fn centralized_mpc(config: &ControllerConfig) -> Result<Centralized, ConfigError> {
+    let mpc = mpc_error(Architecture::Centralized);
+    let (ship_params, tug_params) = mpc_params(config);
+    let (ship, tugs, formation) = prediction_models(config).map_err(&mpc)?;
+    Centralized::new(
+        ship,
+        tugs,
+        formation,
+        ship_params,
+        tug_params,
+        config.tuning.centralized,
+    )
+    .map_err(mpc)
+}
+
 /// The optimizer of the configured architecture, on prediction models with the
 /// configured hulls.
-fn build_optimizer(
-    config: &ControllerConfig,
-    ship_params: towing_mpc::ShipMpcParams,
-    tug_params: towing_mpc::TugMpcParams,
-) -> Result<Box<dyn Optimizer>, ConfigError> {
+fn build_optimizer(config: &ControllerConfig) -> Result<Box<dyn Optimizer>, ConfigError> {
     let t = &config.tuning;
-    let architecture = match t.architecture {
-        Architecture::Distributed => "distributed",
-        Architecture::Centralized => "centralized",
-    };
-    let mpc = |source| ConfigError::Mpc {
-        architecture,
-        source,
-    };
-    let (ship, tugs, formation) = prediction_models(config).map_err(mpc)?;
     Ok(match t.architecture {
         Architecture::Distributed => {
+            let mpc = mpc_error(t.architecture);
+            let (ship_params, tug_params) = mpc_params(config);
+            let (ship, tugs, formation) = prediction_models(config).map_err(&mpc)?;
             let tug = |model| TugMpc::new(model, tug_params).map_err(AdmmBuildError::from);
             let [t1, t2] = tugs;
             Box::new(
                 Admm::new(
                     ShipMpc::new(ship, formation, ship_params).map_err(|e| mpc(e.into()))?,
-                    [tug(t1).map_err(mpc)?, tug(t2).map_err(mpc)?],
+                    [tug(t1).map_err(&mpc)?, tug(t2).map_err(&mpc)?],
                     t.admm,
                 )
                 .map_err(|e| mpc(e.into()))?,
             )
         }
-        Architecture::Centralized => Box::new(
-            Centralized::new(
-                ship,
-                tugs,
-                formation,
-                ship_params,
-                tug_params,
-                t.centralized,
-            )
-            .map_err(mpc)?,
-        ),
+        Architecture::Centralized => Box::new(centralized_mpc(config)?),
     })
 }
 

@@ -27,6 +27,7 @@
 pub mod config;
 pub mod controller;
 pub mod error;
+pub mod mpc_input;
 pub mod params;
 
 pub use config::{
@@ -34,8 +35,9 @@ pub use config::{
     TrackingParams, Tuning, WaterwaySettings,
 };
 pub use controller::{
-    Command, Controller, Fallback, Measurement, Prediction, SampleReport, Step, StepError,
-    SAMPLE_TOLERANCE,
+    centralized_mpc, mpc_params, Command, Controller, Fallback, Measurement, Prediction,
+    SampleReport, Step, StepError, SAMPLE_TOLERANCE,
 };
 pub use error::{ConfigError, MeasurementError};
+pub use mpc_input::MpcInput;
 pub use params::{Parameter, Value, PARAMETERS};
