@@ -5,8 +5,9 @@
 //! The helper is a thread made once (with the [`crate::Admm`]) that owns
 //! nothing but a handle to tug 2's problem; each iteration the loop posts tug
 //! 2's step data, takes tug 1's step itself, and collects tug 2's report and
-//! predicted poses. Between iterations the helper spins briefly (the ship's step
-//! takes tens of microseconds), then parks until the next sample. The helper's
+//! predicted poses. Between iterations the helper waits briefly, yielding its
+//! core (the ship's step takes tens of microseconds), then parks until the next
+//! sample; the caller waits for tug 2's step the same way. The helper's
 //! arithmetic is tug 2's own, so the results are bit-identical to the sequential
 //! loop. A panic on the helper is raised again on the caller's thread; if the
 //! thread cannot be made, tug 2 steps on the caller's thread.
@@ -32,7 +33,7 @@ pub(crate) fn poses(tug: &TugMpc) -> Poses {
     tug.predicted().map(|x| [x[0], x[1], x[2]])
 }
 
-/// How long the helper spins for the next step before it parks: longer than
+/// How long the helper waits (yielding) for the next step before it parks: longer than
 /// the ship's step between two tug steps (about 70 us on the paper scenario),
 /// short against the time between samples.
 const SPIN: Duration = Duration::from_micros(300);
@@ -105,7 +106,10 @@ impl Shared {
                     _ => {
                         let start = *since.get_or_insert_with(Instant::now);
                         if start.elapsed() < SPIN {
-                            std::hint::spin_loop();
+                            // Yield, not spin: on a busy machine (a master, other
+                            // FMUs, a campaign's other runs) a spinning thread
+                            // takes the core the posting thread needs.
+                            std::thread::yield_now();
                         } else {
                             std::thread::park();
                         }
@@ -238,7 +242,8 @@ impl Tug2 {
                     if h.thread.as_ref().is_none_or(JoinHandle::is_finished) {
                         break;
                     }
-                    std::hint::spin_loop();
+                    // As in the helper's wait: leave the core to tug 2's step.
+                    std::thread::yield_now();
                 }
                 h.shared.state.store(IDLE, Ordering::Release);
                 match lock(&h.shared.result).take() {
