@@ -660,6 +660,192 @@ fn pose_of(p: &FilePose) -> Pose {
     }
 }
 
+/// The plant's settings of the `[simulation]` table (defaults where absent).
+fn simulation_of(sim: Option<FileSimulation>) -> (WorldConfig, ElasticTowlineParams) {
+    let mut world_config = WorldConfig::default();
+    let mut elastic_towline = ElasticTowlineParams::default();
+    if let Some(sim) = sim {
+        if let Some(e) = sim.elastic_towline {
+            set(&mut elastic_towline.stiffness, e.stiffness);
+            set(&mut elastic_towline.damping, e.damping);
+            set(&mut elastic_towline.winch_gain, e.winch_gain);
+            set(&mut elastic_towline.winch_speed_max, e.winch_speed_max);
+        }
+        if let Some(h) = sim.hull_model {
+            world_config.hull_model = match h {
+                FileHullModel::LinearDamping => HullModel::LinearDamping,
+                FileHullModel::NonlinearDamping => HullModel::NonlinearDamping,
+            };
+        }
+        if let Some(t) = sim.towline_model {
+            world_config.towline_model = match t {
+                FileTowlineModel::IdealWinch => TowlineModel::IdealWinch,
+                FileTowlineModel::Elastic => elastic_towline.into(),
+            };
+        }
+        set(&mut world_config.integration_step, sim.integration_step);
+    }
+
+    (world_config, elastic_towline)
+}
+
+/// The tugs' initial states and how they were placed: an explicit pose, or the
+/// formation pose of a towing angle behind the ship's initial pose.
+fn tugs_of(
+    file_tugs: [&FileTug; 2],
+    ship: &VesselState,
+    ship_data: &VesselData,
+    tug_data: &[VesselData; 2],
+    towline_desired_length: [f64; 2],
+    origin: &str,
+) -> Result<([VesselState; 2], [TugPlacement; 2]), ScenarioError> {
+    let mut tugs = [VesselState::default(); 2];
+    let mut tug_placement = [TugPlacement::Explicit; 2];
+    for (i, t) in file_tugs.into_iter().enumerate() {
+        let name = format!("tug{}", i + 1);
+        let explicit = [("x", t.x), ("y", t.y), ("psi_deg", t.psi_deg)];
+        match &t.formation {
+            Some(f) => {
+                if let Some((key, _)) = explicit.iter().find(|(_, v)| v.is_some()) {
+                    return Err(ScenarioError::schema(
+                        origin,
+                        format!("{name}.{key}"),
+                        "give either `formation` or an explicit pose (`x`, `y`, `psi_deg`), not both",
+                    ));
+                }
+                let alpha = f.towing_angle_deg.to_radians();
+                tug_placement[i] = TugPlacement::Formation {
+                    towing_angle: alpha,
+                };
+                let eta = formation_pose(
+                    i,
+                    &ship.eta,
+                    ship_data,
+                    &tug_data[i],
+                    towline_desired_length[i],
+                    alpha,
+                );
+                tugs[i] = state_of(eta[0], eta[1], 0.0, t.u, t.v, t.r_deg_s);
+                tugs[i].eta[2] = eta[2];
+            }
+            None => {
+                if let Some((key, _)) = explicit.iter().find(|(_, v)| v.is_none()) {
+                    return Err(ScenarioError::schema(
+                        origin,
+                        format!("{name}.{key}"),
+                        "missing field: an explicit tug pose needs `x`, `y` and `psi_deg` \
+                         (or give `formation = { towing_angle_deg = ... }`)",
+                    ));
+                }
+                tugs[i] = state_of(
+                    t.x.unwrap_or_default(),
+                    t.y.unwrap_or_default(),
+                    t.psi_deg.unwrap_or_default(),
+                    t.u,
+                    t.v,
+                    t.r_deg_s,
+                );
+            }
+        }
+    }
+
+    Ok((tugs, tug_placement))
+}
+
+/// Obstacle `i` of the file, its fields checked against its kind.
+fn obstacle_of(i: usize, o: FileObstacle, origin: &str) -> Result<TrafficObstacle, ScenarioError> {
+    let path = format!("obstacles[{i}]");
+    let given = [
+        ("diameter", o.diameter),
+        ("length", o.length),
+        ("width", o.width),
+        ("course_deg", o.course_deg),
+        ("speed", o.speed),
+        ("activation_time", o.activation_time),
+        ("activation_range", o.activation_range),
+    ];
+    let (required, forbidden, kind): (&[&str], &[&str], &str) = match o.kind {
+        FileObstacleKind::Static => (
+            &["diameter"],
+            &[
+                "length",
+                "width",
+                "course_deg",
+                "speed",
+                "activation_time",
+                "activation_range",
+            ],
+            "static",
+        ),
+        FileObstacleKind::Ship => (
+            &["length", "width", "course_deg", "speed"],
+            &["diameter"],
+            "ship",
+        ),
+    };
+    let value = |key: &str| given.iter().find(|(k, _)| *k == key).and_then(|(_, v)| *v);
+    for key in forbidden {
+        if value(key).is_some() {
+            let why = match o.kind {
+                FileObstacleKind::Static => "static obstacles are circles that do not move",
+                FileObstacleKind::Ship => "a ship's size is its `length` and `width`",
+            };
+            return Err(ScenarioError::schema(
+                origin,
+                format!("{path}.{key}"),
+                format!("not allowed for kind = \"{kind}\" ({why})"),
+            ));
+        }
+    }
+    for key in required {
+        if value(key).is_none() {
+            return Err(ScenarioError::schema(
+                origin,
+                format!("{path}.{key}"),
+                format!("missing field `{key}` (required for kind = \"{kind}\")"),
+            ));
+        }
+    }
+    // The file's time must be finite (`inf` is how the model says "never by
+    // time", which the file says by omitting `activation_time`).
+    if let Some(t) = o.activation_time.filter(|t| t.is_infinite()) {
+        return Err(ScenarioError::invalid(
+            origin,
+            ParamError::new(
+                format!("{path}.activation_time"),
+                format!(
+                    "must be finite, got {t} (omit it and give `activation_range` for a target \
+                     that only the range activates)"
+                ),
+            ),
+        ));
+    }
+    let shape = match o.kind {
+        FileObstacleKind::Static => ObstacleShape::Circle {
+            diameter: o.diameter.unwrap_or_default(),
+        },
+        FileObstacleKind::Ship => ObstacleShape::Vessel {
+            length: o.length.unwrap_or_default(),
+            width: o.width.unwrap_or_default(),
+            course: wrap_angle_keep_nan(o.course_deg.unwrap_or_default().to_radians()),
+            speed: o.speed.unwrap_or_default(),
+            // Neither trigger given: from t = 0; range only: never by time.
+            activation_time: match (o.activation_time, o.activation_range) {
+                (Some(t), _) => t,
+                (None, Some(_)) => f64::INFINITY,
+                (None, None) => 0.0,
+            },
+            activation_range: o.activation_range,
+        },
+    };
+    Ok(TrafficObstacle {
+        name: o.name,
+        x: o.x,
+        y: o.y,
+        shape,
+    })
+}
+
 fn convert(file: FileScenario, origin: &str) -> Result<Scenario, ScenarioError> {
     let vessels = file.vessels.unwrap_or(FileVessels {
         ship: None,
@@ -690,183 +876,32 @@ fn convert(file: FileScenario, origin: &str) -> Result<Scenario, ScenarioError> 
         )?,
     ];
 
-    let mut world_config = WorldConfig::default();
-    let mut elastic_towline = ElasticTowlineParams::default();
-    if let Some(sim) = file.simulation {
-        if let Some(e) = sim.elastic_towline {
-            set(&mut elastic_towline.stiffness, e.stiffness);
-            set(&mut elastic_towline.damping, e.damping);
-            set(&mut elastic_towline.winch_gain, e.winch_gain);
-            set(&mut elastic_towline.winch_speed_max, e.winch_speed_max);
-        }
-        if let Some(h) = sim.hull_model {
-            world_config.hull_model = match h {
-                FileHullModel::LinearDamping => HullModel::LinearDamping,
-                FileHullModel::NonlinearDamping => HullModel::NonlinearDamping,
-            };
-        }
-        if let Some(t) = sim.towline_model {
-            world_config.towline_model = match t {
-                FileTowlineModel::IdealWinch => TowlineModel::IdealWinch,
-                FileTowlineModel::Elastic => elastic_towline.into(),
-            };
-        }
-        set(&mut world_config.integration_step, sim.integration_step);
-    }
-
+    let (world_config, elastic_towline) = simulation_of(file.simulation);
     let s = &file.ship;
     let ship = state_of(s.x, s.y, s.psi_deg, s.u, s.v, s.r_deg_s);
     let towline_desired_length = [file.towline1.desired_length, file.towline2.desired_length];
 
-    let mut tugs = [VesselState::default(); 2];
-    let mut tug_placement = [TugPlacement::Explicit; 2];
-    for (i, t) in [&file.tug1, &file.tug2].into_iter().enumerate() {
-        let name = format!("tug{}", i + 1);
-        let explicit = [("x", t.x), ("y", t.y), ("psi_deg", t.psi_deg)];
-        match &t.formation {
-            Some(f) => {
-                if let Some((key, _)) = explicit.iter().find(|(_, v)| v.is_some()) {
-                    return Err(ScenarioError::schema(
-                        origin,
-                        format!("{name}.{key}"),
-                        "give either `formation` or an explicit pose (`x`, `y`, `psi_deg`), not both",
-                    ));
-                }
-                let alpha = f.towing_angle_deg.to_radians();
-                tug_placement[i] = TugPlacement::Formation {
-                    towing_angle: alpha,
-                };
-                let eta = formation_pose(
-                    i,
-                    &ship.eta,
-                    &ship_data,
-                    &tug_data[i],
-                    towline_desired_length[i],
-                    alpha,
-                );
-                tugs[i] = state_of(eta[0], eta[1], 0.0, t.u, t.v, t.r_deg_s);
-                tugs[i].eta[2] = eta[2];
-            }
-            None => {
-                if let Some((key, _)) = explicit.iter().find(|(_, v)| v.is_none()) {
-                    return Err(ScenarioError::schema(
-                        origin,
-                        format!("{name}.{key}"),
-                        "missing field: an explicit tug pose needs `x`, `y` and `psi_deg` \
-                         (or give `formation = { towing_angle_deg = ... }`)",
-                    ));
-                }
-                tugs[i] = state_of(
-                    t.x.unwrap_or_default(),
-                    t.y.unwrap_or_default(),
-                    t.psi_deg.unwrap_or_default(),
-                    t.u,
-                    t.v,
-                    t.r_deg_s,
-                );
-            }
-        }
-    }
-
+    let (tugs, tug_placement) = tugs_of(
+        [&file.tug1, &file.tug2],
+        &ship,
+        &ship_data,
+        &tug_data,
+        towline_desired_length,
+        origin,
+    )?;
     let route = Route {
         origin: pose_of(&file.route.origin),
         waypoints: file.route.waypoints.iter().map(pose_of).collect(),
         destination: pose_of(&file.route.destination),
     };
 
-    let mut obstacles = Vec::new();
-    for (i, o) in file.obstacles.unwrap_or_default().into_iter().enumerate() {
-        let path = format!("obstacles[{i}]");
-        let given = [
-            ("diameter", o.diameter),
-            ("length", o.length),
-            ("width", o.width),
-            ("course_deg", o.course_deg),
-            ("speed", o.speed),
-            ("activation_time", o.activation_time),
-            ("activation_range", o.activation_range),
-        ];
-        let (required, forbidden, kind): (&[&str], &[&str], &str) = match o.kind {
-            FileObstacleKind::Static => (
-                &["diameter"],
-                &[
-                    "length",
-                    "width",
-                    "course_deg",
-                    "speed",
-                    "activation_time",
-                    "activation_range",
-                ],
-                "static",
-            ),
-            FileObstacleKind::Ship => (
-                &["length", "width", "course_deg", "speed"],
-                &["diameter"],
-                "ship",
-            ),
-        };
-        let value = |key: &str| given.iter().find(|(k, _)| *k == key).and_then(|(_, v)| *v);
-        for key in forbidden {
-            if value(key).is_some() {
-                let why = match o.kind {
-                    FileObstacleKind::Static => "static obstacles are circles that do not move",
-                    FileObstacleKind::Ship => "a ship's size is its `length` and `width`",
-                };
-                return Err(ScenarioError::schema(
-                    origin,
-                    format!("{path}.{key}"),
-                    format!("not allowed for kind = \"{kind}\" ({why})"),
-                ));
-            }
-        }
-        for key in required {
-            if value(key).is_none() {
-                return Err(ScenarioError::schema(
-                    origin,
-                    format!("{path}.{key}"),
-                    format!("missing field `{key}` (required for kind = \"{kind}\")"),
-                ));
-            }
-        }
-        // The file's time must be finite (`inf` is how the model says "never by
-        // time", which the file says by omitting `activation_time`).
-        if let Some(t) = o.activation_time.filter(|t| t.is_infinite()) {
-            return Err(ScenarioError::invalid(
-                origin,
-                ParamError::new(
-                    format!("{path}.activation_time"),
-                    format!(
-                        "must be finite, got {t} (omit it and give `activation_range` for a target \
-                         that only the range activates)"
-                    ),
-                ),
-            ));
-        }
-        let shape = match o.kind {
-            FileObstacleKind::Static => ObstacleShape::Circle {
-                diameter: o.diameter.unwrap_or_default(),
-            },
-            FileObstacleKind::Ship => ObstacleShape::Vessel {
-                length: o.length.unwrap_or_default(),
-                width: o.width.unwrap_or_default(),
-                course: wrap_angle_keep_nan(o.course_deg.unwrap_or_default().to_radians()),
-                speed: o.speed.unwrap_or_default(),
-                // Neither trigger given: from t = 0; range only: never by time.
-                activation_time: match (o.activation_time, o.activation_range) {
-                    (Some(t), _) => t,
-                    (None, Some(_)) => f64::INFINITY,
-                    (None, None) => 0.0,
-                },
-                activation_range: o.activation_range,
-            },
-        };
-        obstacles.push(TrafficObstacle {
-            name: o.name,
-            x: o.x,
-            y: o.y,
-            shape,
-        });
-    }
+    let obstacles = file
+        .obstacles
+        .unwrap_or_default()
+        .into_iter()
+        .enumerate()
+        .map(|(i, o)| obstacle_of(i, o, origin))
+        .collect::<Result<Vec<_>, _>>()?;
 
     Ok(Scenario {
         origin: origin.to_owned(),
