@@ -371,8 +371,8 @@ fn problem_json(config: &ControllerConfig) -> Res<Value> {
         "tug_hulls": [hull_json(config.hull(), &s.tug_data[0])?, hull_json(config.hull(), &s.tug_data[1])?],
         "towline_desired_length": s.towline_desired_length,
         "ship": {
-            "pose_weights": [ship.weight_position, ship.weight_position, ship.weight_heading],
-            "velocity_weights": [ship.weight_surge, ship.weight_sway, ship.weight_yaw_rate],
+            "pose_weights": ship.state_weights().0,
+            "velocity_weights": ship.state_weights().1,
             "weight_distance": ship.weight_distance,
             "min_tension": ship.min_tension,
             "max_tension": ship.max_tension,
@@ -387,8 +387,8 @@ fn problem_json(config: &ControllerConfig) -> Res<Value> {
             "weight_port_turn": ship.weight_port_turn,
         },
         "tug": {
-            "pose_weights": [tug.weight_position, tug.weight_position, tug.weight_heading],
-            "velocity_weights": [tug.weight_surge, tug.weight_sway, tug.weight_yaw_rate],
+            "pose_weights": tug.state_weights().0,
+            "velocity_weights": tug.state_weights().1,
             "weight_distance": tug.weight_distance,
             "thrust_limit": tug.thrust_limit,
             "distance": distance(&tug.distance),
@@ -403,22 +403,6 @@ fn problem_json(config: &ControllerConfig) -> Res<Value> {
     }))
 }
 
-fn obstacle_json(o: &Obstacle) -> Value {
-    match *o {
-        Obstacle::Circle { centre, radius } => {
-            json!({"kind": "circle", "centre": centre, "radius": radius})
-        }
-        Obstacle::Ellipse {
-            centre,
-            semi_major,
-            semi_minor,
-            orientation,
-            drift,
-        } => json!({"kind": "ellipse", "centre": centre, "semi_major": semi_major,
-                    "semi_minor": semi_minor, "orientation": orientation, "drift": drift}),
-    }
-}
-
 fn sample_json(s: &Recorded) -> Value {
     let i = &s.input;
     json!({
@@ -428,7 +412,7 @@ fn sample_json(s: &Recorded) -> Value {
         "previous": {"ship": i.previous.ship, "tugs": i.previous.tugs},
         "reference": i.reference,
         "heading_floor": i.heading_floor,
-        "obstacles": i.obstacles().iter().map(obstacle_json).collect::<Vec<_>>(),
+        "obstacles": i.obstacles(),
         "loop": {"ship": s.ship, "tugs": s.tugs, "fallback": s.fallback},
     })
 }
@@ -484,27 +468,6 @@ fn nested<const M: usize, const N: usize>(v: &Value, what: &str) -> Res<[[f64; N
     Ok(out)
 }
 
-fn obstacle_from(v: &Value, what: &str) -> Res<Obstacle> {
-    let num = |k: &str| {
-        v[k].as_f64()
-            .ok_or_else(|| format!("{what}.{k}: not a number"))
-    };
-    match v["kind"].as_str() {
-        Some("circle") => Ok(Obstacle::Circle {
-            centre: floats(&v["centre"], &format!("{what}.centre"))?,
-            radius: num("radius")?,
-        }),
-        Some("ellipse") => Ok(Obstacle::Ellipse {
-            centre: floats(&v["centre"], &format!("{what}.centre"))?,
-            semi_major: num("semi_major")?,
-            semi_minor: num("semi_minor")?,
-            orientation: num("orientation")?,
-            drift: floats(&v["drift"], &format!("{what}.drift"))?,
-        }),
-        other => Err(format!("{what}.kind: {other:?} is neither circle nor ellipse").into()),
-    }
-}
-
 /// The MPC input of a recorded sample (the form `sample_json` writes).
 fn input_from(v: &Value, k: usize) -> Res<MpcInput> {
     let what = format!("samples[{k}]");
@@ -513,7 +476,10 @@ fn input_from(v: &Value, k: usize) -> Res<MpcInput> {
         .ok_or_else(|| format!("{what}.obstacles: not a list"))?
         .iter()
         .enumerate()
-        .map(|(j, o)| obstacle_from(o, &format!("{what}.obstacles[{j}]")))
+        .map(|(j, o)| {
+            serde_json::from_value::<Obstacle>(o.clone())
+                .map_err(|e| format!("{what}.obstacles[{j}]: {e}").into())
+        })
         .collect::<Res<Vec<_>>>()?;
     let heading_floor = match &v["heading_floor"] {
         Value::Null => None,

@@ -155,16 +155,7 @@ pub(crate) fn ship_stage_terms<const N: usize>(
         x[1] - reference[1],
         angle_difference(x[2], reference[2]),
     ];
-    let wp = [
-        params.weight_position,
-        params.weight_position,
-        params.weight_heading,
-    ];
-    let wv = [
-        params.weight_surge,
-        params.weight_sway,
-        params.weight_yaw_rate,
-    ];
+    let (wp, wv) = params.state_weights();
     for c in 0..3 {
         quad.residual(err[c], wp[c], 0.0, &rows[c]);
         quad.residual(x[3 + c], wv[c], 0.0, &rows[3 + c]);

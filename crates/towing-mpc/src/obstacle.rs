@@ -14,8 +14,11 @@
 //! Both are measured from the vessel's centre of origin; the own hull size goes
 //! into `d_safe` (and, later, the clearance rows).
 
-/// A static obstacle (module docs). Lengths in m, angles in rad.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A static obstacle (module docs). Lengths in m, angles in rad. Serialized as
+/// an object tagged by `kind` (`circle`, `ellipse`) with the fields by name (the
+/// recorded problems of the side-by-side baseline, docs/benchmarks.md).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
 pub enum Obstacle {
     /// A circle.
     Circle {

@@ -148,6 +148,20 @@ pub struct TerminalCost {
 }
 
 impl ShipMpcParams {
+    /// The pose-error weights `[x, y, psi]` and the velocity weights `[u, v, r]`
+    /// (as [`crate::TugMpcParams::state_weights`]).
+    #[must_use]
+    pub fn state_weights(&self) -> ([f64; 3], [f64; 3]) {
+        (
+            [
+                self.weight_position,
+                self.weight_position,
+                self.weight_heading,
+            ],
+            [self.weight_surge, self.weight_sway, self.weight_yaw_rate],
+        )
+    }
+
     /// `(lower, upper, largest change per sample)` of channel `k` (0, 1:
     /// tensions; 2, 3: angles) for samples of `sample_time` s: eq. (17)-(18)
     /// and (20)-(21).
