@@ -22,27 +22,39 @@
 //! Loading the scenario and the log's life cycle are `towing-interface`'s [`RunSession`],
 //! which the plant uses too.
 //!
-//! FMU state: the solvers' warm starts and factorisations cannot be copied, so the FMU
-//! declares `canGetAndSetFMUstate="false"`. The layer still clones the model on
-//! `fmi2GetFMUstate`; a clone carries no controller, and an instance restored from one
-//! refuses to step with a message saying why (never a silent cold start).
+//! FMU state (FMI 2.0 section 2.1.8; `canGetAndSetFMUstate`, `canSerializeFMUstate`): the
+//! parameters, inputs, outputs, the scenario as loaded, the time and the controller's
+//! [`ControllerState`] (guidance memory, plans, multipliers, warm starts, spare plan, the
+//! inner loop's ramp, the sample clock). A copy for an FMU state carries that state, not
+//! the solvers; `fmi2SetFMUstate` restores it into the instance's controller, rebuilt from
+//! the state's configuration when that differs, and the next steps continue bit for bit.
+//! The log, `log_file` and `run_id` stay the instance's.
 
 use crate::diagnostics::Outputs;
 use crate::logging::{self, Sample};
 use crate::variables::{self as vars, ControllerVariable as V};
+use fmi2_slave::codec::{put_header, put_value, Reader};
 use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome, ValueType};
+use serde::{Deserialize, Serialize};
 use towing_control::params::{Value, PARAMETERS};
-use towing_control::{ConfigError, Controller, ControllerConfig, Measurement, Tuning};
+use towing_control::{
+    ConfigError, Controller, ControllerConfig, ControllerState, Measurement, Tuning,
+};
 use towing_interface::codec::{
     obstacle_kind_code, obstacle_kind_from_code, ContractVariable, ObstacleField, TowlineField,
     Vessel,
 };
-use towing_interface::{parameters, LogHeader, RunSession};
+use towing_interface::{parameters, LogHeader, RunSession, ScenarioFile};
 
 const STATE_MAGIC: &[u8; 4] = b"TWCT";
+/// Version of the controller's serialized state; bump on any change of [`SavedState`] or
+/// of what it holds.
+const STATE_FORMAT_VERSION: u16 = 1;
+/// Names the controller's part in the messages of a refused state.
+const STATE_OWNER: &str = "TowingController state";
 
 /// The inputs: the plant's outputs.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 struct Inputs {
     measurement: Measurement,
     /// Towline length, angle, tension (accepted, not used by the controller).
@@ -109,6 +121,17 @@ impl Inputs {
     }
 }
 
+/// The controller of an instance, or of a copy kept for an FMU state.
+#[derive(Debug)]
+enum Core {
+    /// Not built (before initialization ends).
+    None,
+    /// The instance's controller.
+    Live(Box<Controller>),
+    /// A copy's: the controller's state without its solvers (module docs).
+    Saved(Box<ControllerState>),
+}
+
 /// The controller FMU's model.
 #[derive(Debug)]
 pub struct ControllerFmu {
@@ -121,29 +144,67 @@ pub struct ControllerFmu {
     /// `scenario`, `log_file`, the scenario as loaded and the MCAP log (open from the end
     /// of initialization while `log_file` is set; shared with copies).
     session: RunSession,
-    controller: Option<Controller>,
+    core: Core,
     /// `setupExperiment`'s start time: the first sample instant.
     start_time: f64,
-    /// This value is a copy made by `fmi2GetFMUstate` of an initialized instance: it has
-    /// no controller and refuses to step.
-    copied_without_controller: bool,
+    /// The end of the last step (the start time before the first).
+    time: f64,
 }
 
 impl Clone for ControllerFmu {
-    /// Copies everything but the [`Controller`], whose solvers cannot be copied (module
-    /// docs): the copy refuses to step.
+    /// Copies everything; the controller as its [`ControllerState`] (the solvers are
+    /// rebuilt when a copy is restored, [`Fmi2Model::restore_state`]).
     fn clone(&self) -> Self {
+        let core = match &self.core {
+            Core::None => Core::None,
+            Core::Live(c) => Core::Saved(Box::new(c.snapshot())),
+            Core::Saved(s) => Core::Saved(s.clone()),
+        };
+        self.with(self.session.clone(), core)
+    }
+}
+
+impl ControllerFmu {
+    /// A copy of everything but the session and the controller, which are given.
+    fn with(&self, session: RunSession, core: Core) -> Self {
         Self {
             params: self.params,
             inputs: self.inputs,
             outputs: self.outputs,
             initializing: self.initializing,
-            session: self.session.clone(),
-            controller: None,
+            session,
+            core,
             start_time: self.start_time,
-            copied_without_controller: self.controller.is_some() || self.copied_without_controller,
+            time: self.time,
         }
     }
+}
+
+/// The controller's part of a serialized FMU state (MessagePack, [`fmi2_slave::codec`]).
+#[derive(Debug, Serialize, Deserialize)]
+struct SavedState {
+    start_time: f64,
+    time: f64,
+    scenario_parameter: String,
+    parameters: Vec<Value>,
+    inputs: Inputs,
+    outputs: Outputs,
+    initializing: bool,
+    /// The scenario as loaded: origin and text.
+    scenario: Option<(String, String)>,
+    controller: Option<ControllerState>,
+}
+
+/// A controller of `params` for `scenario`, in the state `state`.
+fn controller_in(
+    params: Tuning,
+    scenario: &ScenarioFile,
+    state: &ControllerState,
+) -> Result<Controller, String> {
+    let config = ControllerConfig::with_tuning(scenario.scenario.clone(), params);
+    let mut controller = Controller::new(config).map_err(|e| e.to_string())?;
+    controller.restore(state)?;
+    Ok(controller)
 }
 
 impl ControllerFmu {
@@ -198,9 +259,9 @@ impl Fmi2Model for ControllerFmu {
             outputs: Outputs::default(),
             initializing: false,
             session: RunSession::new(ctx.resource_dir),
-            controller: None,
+            core: Core::None,
             start_time: 0.0,
-            copied_without_controller: false,
+            time: 0.0,
         })
     }
 
@@ -212,6 +273,7 @@ impl Fmi2Model for ControllerFmu {
         _tolerance: Option<f64>,
     ) -> Result<(), String> {
         self.start_time = start_time;
+        self.time = start_time;
         Ok(())
     }
 
@@ -238,7 +300,7 @@ impl Fmi2Model for ControllerFmu {
         let start = controller.applied();
         self.outputs.command.tension = [start.ship[0], start.ship[1]];
         self.outputs.command.tug_thrust = start.tugs;
-        self.controller = Some(controller);
+        self.core = Core::Live(Box::new(controller));
         log.info(
             "logEvents",
             &format!(
@@ -358,15 +420,18 @@ impl Fmi2Model for ControllerFmu {
     }
 
     fn do_step(&mut self, _log: &Logger, step: &StepContext) -> StepOutcome {
-        let Some(controller) = self.controller.as_mut() else {
-            return StepOutcome::Error(if self.copied_without_controller {
-                "this instance was restored from an FMU state, which TowingController does not support \
-                 (canGetAndSetFMUstate=\"false\": the solvers' warm starts and factorisations cannot be copied); \
-                 re-instantiate or fmi2Reset and initialize again"
-                    .to_owned()
-            } else {
-                "the controller is not built (initialization did not complete)".to_owned()
-            });
+        let controller = match &mut self.core {
+            Core::Live(c) => c,
+            Core::None => {
+                return StepOutcome::Error(
+                    "the controller is not built (initialization did not complete)".to_owned(),
+                )
+            }
+            Core::Saved(_) => {
+                return StepOutcome::Error(
+                    "internal: a copy kept for an FMU state was stepped".to_owned(),
+                )
+            }
         };
         let step_result = match controller.step(step.current_time, &self.inputs.measurement) {
             Ok(done) => done,
@@ -383,15 +448,16 @@ impl Fmi2Model for ControllerFmu {
                     step.current_time
                 ));
             }
-            if self.session.log().is_active() {
-                sampled = Some(report);
-            }
+            sampled = Some(report);
         }
-        if let Some(report) = sampled {
-            let warning = match &outcome {
-                StepOutcome::Warning(m) => Some(m.clone()),
-                _ => None,
-            };
+        self.time = step.current_time + step.step_size;
+        let warning = match &outcome {
+            StepOutcome::Warning(m) => Some(m.clone()),
+            _ => None,
+        };
+        // A logging failure is a warning (docs/interface.md, "MCAP log").
+        let failed = self.session.log_step(|| {
+            let report = sampled?;
             let sample = Sample {
                 t: step.current_time,
                 report,
@@ -404,16 +470,13 @@ impl Fmi2Model for ControllerFmu {
                 scheme_alters: self.params.scheme.alters(),
                 warning,
             };
-            let failed = self
-                .session
-                .log()
-                .batch(Box::new(move |w| logging::write_sample(w, &sample)));
-            if let Some(failed) = failed {
-                outcome = match outcome {
-                    StepOutcome::Warning(m) => StepOutcome::Warning(format!("{m}; {failed}")),
-                    _ => StepOutcome::Warning(failed),
-                };
-            }
+            Some(Box::new(move |w| logging::write_sample(w, &sample)))
+        });
+        if let Some(failed) = failed {
+            outcome = match outcome {
+                StepOutcome::Warning(m) => StepOutcome::Warning(format!("{m}; {failed}")),
+                _ => StepOutcome::Warning(failed),
+            };
         }
         outcome
     }
@@ -426,17 +489,111 @@ impl Fmi2Model for ControllerFmu {
         self.session.release(log);
     }
 
-    /// Writes only a marker: the state is not serialisable (`canSerializeFMUstate="false"`),
-    /// and [`deserialize_state`](Self::deserialize_state) refuses every input.
-    fn serialize_state(&self, out: &mut Vec<u8>) {
-        out.extend_from_slice(STATE_MAGIC);
+    fn serialize_state(&self, out: &mut Vec<u8>) -> Result<(), String> {
+        let controller = match &self.core {
+            Core::None => None,
+            Core::Live(c) => Some(c.snapshot()),
+            Core::Saved(s) => Some((**s).clone()),
+        };
+        let saved = SavedState {
+            start_time: self.start_time,
+            time: self.time,
+            scenario_parameter: self.session.scenario_parameter().to_owned(),
+            parameters: parameters::values(PARAMETERS, &self.params),
+            inputs: self.inputs,
+            outputs: self.outputs,
+            initializing: self.initializing,
+            scenario: self
+                .session
+                .loaded()
+                .map(|f| (f.origin.clone(), f.text.clone())),
+            controller,
+        };
+        put_header(out, STATE_MAGIC, STATE_FORMAT_VERSION);
+        put_value(out, &saved).map_err(|e| format!("{STATE_OWNER}: {e}"))
     }
 
-    fn deserialize_state(&mut self, _log: &Logger, _bytes: &[u8]) -> Result<(), String> {
-        Err(
-            "TowingController does not support FMU state serialization (canSerializeFMUstate=\"false\"): \
-             the solvers' warm starts and factorisations are not serialisable"
-                .to_owned(),
-        )
+    /// Reads the state and checks it completely: the controller is rebuilt from the
+    /// state's parameters and scenario and restored (then dropped: the copy keeps the
+    /// state, [`restore_state`](Self::restore_state) builds again).
+    fn deserialize_state(&mut self, _log: &Logger, bytes: &[u8]) -> Result<(), String> {
+        let mut r = Reader::new(bytes, STATE_OWNER);
+        r.header(STATE_MAGIC, STATE_FORMAT_VERSION)?;
+        let saved: SavedState = r.value("the controller state")?;
+        r.finish()?;
+        let owned = |e: String| format!("{STATE_OWNER}: {e}");
+        let params = parameters::from_values(PARAMETERS, &saved.parameters).map_err(owned)?;
+        let loaded = saved
+            .scenario
+            .map(|(origin, text)| ScenarioFile::parse(origin, text))
+            .transpose()?;
+        let core = match (saved.controller, &loaded) {
+            (None, _) => Core::None,
+            (Some(state), Some(file)) => {
+                controller_in(params, file, &state).map_err(owned)?;
+                Core::Saved(Box::new(state))
+            }
+            (Some(_), None) => {
+                return Err(owned("a controller state without a scenario".to_owned()))
+            }
+        };
+        let mut session = self.session.clone();
+        session.restore(saved.scenario_parameter, loaded);
+        *self = Self {
+            params,
+            inputs: saved.inputs,
+            outputs: saved.outputs,
+            initializing: saved.initializing,
+            session,
+            core,
+            start_time: saved.start_time,
+            time: saved.time,
+        };
+        Ok(())
+    }
+
+    /// Becomes `saved`, keeping the instance's log: the controller is restored from the
+    /// copy's state into this instance's controller when both have the same parameters and
+    /// scenario, else into one built anew (module docs).
+    fn restore_state(&mut self, _log: &Logger, saved: &Self) -> Result<(), String> {
+        let core = match (&saved.core, std::mem::replace(&mut self.core, Core::None)) {
+            (Core::Saved(state), Core::Live(mut live))
+                if self.params == saved.params
+                    && self.session.loaded().map(|f| &f.text)
+                        == saved.session.loaded().map(|f| &f.text) =>
+            {
+                let restored = live.restore(state);
+                self.core = Core::Live(live);
+                restored?;
+                std::mem::replace(&mut self.core, Core::None)
+            }
+            (Core::Saved(state), previous) => {
+                let file = saved.session.loaded();
+                let built = file
+                    .ok_or_else(|| "the FMU state has a controller but no scenario".to_owned())
+                    .and_then(|f| controller_in(saved.params, f, state));
+                match built {
+                    Ok(c) => Core::Live(Box::new(c)),
+                    Err(e) => {
+                        self.core = previous;
+                        return Err(e);
+                    }
+                }
+            }
+            (Core::None, _) => Core::None,
+            (Core::Live(_), previous) => {
+                self.core = previous;
+                return Err("internal: an FMU state holds a live controller".to_owned());
+            }
+        };
+        let mut session = std::mem::take(&mut self.session);
+        session.restore_from(&saved.session);
+        *self = saved.with(session, core);
+        Ok(())
+    }
+
+    /// The end of the last step, once initialized.
+    fn time(&self) -> Option<f64> {
+        Some(self.time)
     }
 }

@@ -77,7 +77,8 @@ pub const fn prediction(step: u32, vessel: u32, axis: u32) -> u32 {
 pub const NO_OBSTACLE_DISTANCE: f64 = 1e6;
 
 /// The outputs: commands and diagnostics, holding their start values until the first step.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Part of the FMU state (serde).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Outputs {
     pub(crate) command: Command,
     pub(crate) iterations: i32,

@@ -143,7 +143,7 @@ pub const INFO: ModelInfo = ModelInfo {
         RealType::new("ForceWeight", "1/N2", None, (-2, -2, 4, 0)),
         RealType::new("MomentWeight", "1/(N.m)2", None, (-2, -4, 4, 0)),
     ],
-    fmu_state: false,
+    fmu_state: true,
 };
 
 /// The controller's model description, built once.

@@ -170,3 +170,37 @@ fn a_log_file_that_cannot_be_created_is_an_error_naming_it() {
     let path = "/nonexistent-dir/controller.mcap";
     assert_uncreatable_log_file_is_named(&logging_to("bad", Path::new(path)), path);
 }
+
+/// Regression (issue 15, item 8): a log write that fails during the run is reported by the
+/// next step, every run, also when that step has no sample to write. The log's writes fail
+/// from the end of initialization on (a file size limit in a process of its own); the
+/// first write to the file comes when the chunk of 0..10 s is flushed, with the sample at
+/// 10 s in the step with index 100; the step with index 101 returns fmi2Warning, in each of
+/// 3 runs.
+#[test]
+fn a_log_write_failure_is_reported_by_the_next_step_every_time() {
+    use towing_interface::testing::{limit_file_size, rerun_in_child};
+    if !rerun_in_child("a_log_write_failure_is_reported_by_the_next_step_every_time") {
+        return;
+    }
+    for run in 0..3 {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("limited.mcap");
+        let fmu = logging_to("limited", &path);
+        fmu.init(0.0, None);
+        limit_file_size(Some(std::fs::metadata(&path).unwrap().len()));
+        let statuses = (0..150).map(|k| fmu.step(k as f64 * 0.1, 0.1));
+        let odd: Vec<_> = statuses
+            .enumerate()
+            .filter(|(_, s)| *s != Fmi2Status::Ok)
+            .collect();
+        let text = fmu.log_text();
+        assert_eq!(fmu.terminate(), Fmi2Status::Error);
+        limit_file_size(None);
+        assert_eq!(odd, [(101, Fmi2Status::Warning)], "run {run}: {text}");
+        assert!(
+            text.contains("logging stopped") && text.contains("File too large"),
+            "{text}"
+        );
+    }
+}

@@ -12,10 +12,10 @@ use towing_model::Scenario;
 towing_interface::model_description_tests!(DESCRIPTION, VARIABLES);
 
 #[test]
-fn fmu_state_capabilities_are_declared_false() {
+fn fmu_state_capabilities_are_declared() {
     let xml = model_description_xml();
-    assert!(xml.contains("canGetAndSetFMUstate=\"false\""), "{xml}");
-    assert!(xml.contains("canSerializeFMUstate=\"false\""), "{xml}");
+    assert!(xml.contains("canGetAndSetFMUstate=\"true\""), "{xml}");
+    assert!(xml.contains("canSerializeFMUstate=\"true\""), "{xml}");
     assert!(xml.contains(&DESCRIPTION.guid()));
 }
 

@@ -8,13 +8,15 @@
 //! MCAP log (docs/logging.md): with `log_file` set, the file is created when initialization
 //! ends (with the state at the start time) and gets every topic after each step; terminate
 //! closes it (a failure is `fmi2Error`), and `fmi2FreeInstance` closes it if terminate did
-//! not. The log is the instance's own: it is not part of the FMU state, and the copies the
-//! layer keeps for FMU states share it. Loading the scenario and the log's life cycle are
+//! not. The log is the instance's own: it is not part of the FMU state (`fmi2SetFMUstate`
+//! keeps the instance's log, [`RunSession::restore_from`]), and the copies the layer keeps
+//! for FMU states share it. Loading the scenario and the log's life cycle are
 //! `towing-interface`'s [`RunSession`], which the controller uses too.
 
 use crate::logging::{self, LogScenario, StepSnapshot};
 use crate::params::{PlantParams, PARAMETERS};
 use crate::variables::{self as vars, PlantVariable};
+use fmi2_slave::codec::{put_bytes, put_f64, put_header, put_str, put_value, Reader};
 use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome, ValueType};
 use std::sync::Arc;
 use towing_interface::codec::{
@@ -22,11 +24,14 @@ use towing_interface::codec::{
 };
 use towing_interface::{parameters, LogHeader, RunSession, ScenarioFile};
 use towing_log::topics::Log;
-use towing_model::registry::{Kind, Value};
+use towing_log::writer::Batch;
+use towing_model::registry::Value;
 use towing_model::{ObstacleSlot, TowlineOutput, World, WorldInputs};
 
-/// Version of [`Plant`]'s serialized state; bump on any layout change.
-const STATE_FORMAT_VERSION: u16 = 2;
+/// Version of [`Plant`]'s serialized state; bump on any layout change (3: the start time).
+const STATE_FORMAT_VERSION: u16 = 3;
+/// Names the plant's part in the messages of a refused state.
+const STATE_OWNER: &str = "TowingPlant state";
 const STATE_MAGIC: &[u8; 4] = b"TWPL";
 
 /// What the plant builds from the loaded scenario: the world, and what the log needs from
@@ -134,10 +139,10 @@ impl Plant {
         })
     }
 
-    /// Writes the state at the end `t` of the step that began at `t_prev`; the Foxglove
-    /// topics only when the step crossed a multiple of `log_scene_interval` (counted from
-    /// the start time). A logging failure becomes a warning.
-    fn log_step(&self, t_prev: f64, t: f64) -> Option<String> {
+    /// The messages of the state at the end `t` of the step that began at `t_prev`; the
+    /// Foxglove topics only when the step crossed a multiple of `log_scene_interval`
+    /// (counted from the start time).
+    fn state_messages(&self, t_prev: f64, t: f64) -> Option<Batch> {
         let built = self.built.as_ref()?;
         let snap = StepSnapshot::capture(t, &built.world, &self.inputs);
         let info = Arc::clone(&built.log_info);
@@ -146,17 +151,15 @@ impl Plant {
             t_prev - self.start_time,
             t - self.start_time,
         );
-        self.session.log().batch(Box::new(move |w| {
+        Some(Box::new(move |w| {
             logging::write_state(w, &snap, &info, scene)
         }))
     }
 
-    /// Writes a warning or error the plant reports to `/plant/log`.
-    fn log_line(&self, t: f64, level: i32, message: &str) -> Option<String> {
+    /// The message of a warning or error the plant reports, for `/plant/log`.
+    fn line_message(t: f64, level: i32, message: &str) -> Batch {
         let message = message.to_owned();
-        self.session.log().batch(Box::new(move |w| {
-            logging::write_log_line(w, t, level, &message)
-        }))
+        Box::new(move |w| logging::write_log_line(w, t, level, &message))
     }
 }
 
@@ -327,23 +330,25 @@ impl Fmi2Model for Plant {
                 built.world.time()
             )),
         };
-        if !self.session.log().is_active() {
-            return outcome;
-        }
-        let failed = match &outcome {
+        // A logging failure is a warning (docs/interface.md, "MCAP log").
+        let failed = self.session.log_step(|| match &outcome {
             StepOutcome::Ok | StepOutcome::Warning(_) => {
-                self.log_step(step.current_time, step.current_time + step.step_size)
+                self.state_messages(step.current_time, step.current_time + step.step_size)
             }
             StepOutcome::Discard(m) | StepOutcome::Error(m) => {
-                self.log_line(step.current_time, Log::ERROR, m)
+                Some(Self::line_message(step.current_time, Log::ERROR, m))
             }
-        };
+        });
         match (failed, outcome) {
             (Some(warning), StepOutcome::Ok) => StepOutcome::Warning(warning),
             (Some(warning), StepOutcome::Warning(m)) => {
                 StepOutcome::Warning(format!("{m}; {warning}"))
             }
-            (_, outcome) => outcome,
+            (Some(warning), StepOutcome::Discard(m)) => {
+                StepOutcome::Discard(format!("{m}; {warning}"))
+            }
+            (Some(warning), StepOutcome::Error(m)) => StepOutcome::Error(format!("{m}; {warning}")),
+            (None, outcome) => outcome,
         }
     }
 
@@ -355,25 +360,19 @@ impl Fmi2Model for Plant {
         self.session.release(log);
     }
 
-    fn serialize_state(&self, out: &mut Vec<u8>) {
-        out.extend_from_slice(STATE_MAGIC);
-        out.extend_from_slice(&STATE_FORMAT_VERSION.to_le_bytes());
+    fn serialize_state(&self, out: &mut Vec<u8>) -> Result<(), String> {
+        put_header(out, STATE_MAGIC, STATE_FORMAT_VERSION);
+        put_f64(out, self.start_time);
         put_str(out, self.session.scenario_parameter());
-        for p in PARAMETERS {
-            match p.get(&self.params) {
-                Value::Real(v) => out.extend_from_slice(&v.to_le_bytes()),
-                Value::Integer(v) => out.extend_from_slice(&v.to_le_bytes()),
-                Value::Boolean(v) => out.push(u8::from(v)),
-                Value::String(v) => put_str(out, &v),
-            }
-        }
-        for tau in &self.inputs.tug_tau {
-            for x in tau {
-                out.extend_from_slice(&x.to_le_bytes());
-            }
-        }
-        for x in &self.inputs.tension_cmd {
-            out.extend_from_slice(&x.to_le_bytes());
+        put_value(out, &parameters::values(PARAMETERS, &self.params))?;
+        for x in self
+            .inputs
+            .tug_tau
+            .iter()
+            .flatten()
+            .chain(&self.inputs.tension_cmd)
+        {
+            put_f64(out, *x);
         }
         out.push(u8::from(self.initializing));
         match (self.session.loaded(), &self.built) {
@@ -387,44 +386,25 @@ impl Fmi2Model for Plant {
             }
             _ => out.push(0),
         }
+        Ok(())
     }
 
     fn deserialize_state(&mut self, _log: &Logger, bytes: &[u8]) -> Result<(), String> {
-        let mut r = Reader { bytes, pos: 0 };
-        if r.take(4)? != STATE_MAGIC {
-            return Err("not a TowingPlant state (wrong magic)".to_owned());
-        }
-        let version = u16::from_le_bytes(r.array()?);
-        if version != STATE_FORMAT_VERSION {
-            return Err(format!(
-                "TowingPlant state format version {version} is not supported (this build reads {STATE_FORMAT_VERSION})"
-            ));
-        }
-        let scenario_parameter = r.string()?;
-        let mut params = PlantParams::default();
-        for p in PARAMETERS {
-            let value = match p.kind {
-                Kind::Real { .. } => Value::Real(f64::from_le_bytes(r.array()?)),
-                Kind::Integer { .. } | Kind::Enumeration { .. } => {
-                    Value::Integer(i32::from_le_bytes(r.array()?))
-                }
-                Kind::Boolean { .. } => Value::Boolean(r.take(1)?[0] != 0),
-                Kind::String { .. } => Value::String(r.string()?),
-            };
-            p.check(&value)
-                .map_err(|e| format!("TowingPlant state: parameter `{}`: {}", e.field, e.reason))?;
-            p.set(&mut params, value).map_err(|e| e.to_string())?;
-        }
+        let mut r = Reader::new(bytes, STATE_OWNER);
+        r.header(STATE_MAGIC, STATE_FORMAT_VERSION)?;
+        let start_time = r.finite_f64("the start time")?;
+        let scenario_parameter = r.string("the scenario parameter")?;
+        let values: Vec<Value> = r.value("the parameters")?;
+        let params = parameters::from_values(PARAMETERS, &values)
+            .map_err(|e| format!("{STATE_OWNER}: {e}"))?;
         let mut inputs = WorldInputs::default();
-        for tau in &mut inputs.tug_tau {
-            for x in tau.iter_mut() {
-                *x = f64::from_le_bytes(r.array()?);
-            }
+        for x in inputs.tug_tau.iter_mut().flatten() {
+            *x = r.finite_f64("a tug force input")?;
         }
         for x in &mut inputs.tension_cmd {
-            *x = f64::from_le_bytes(r.array()?);
+            *x = r.finite_f64("a tension command input")?;
         }
-        let initializing = r.take(1)?[0] != 0;
+        let initializing = r.flag("the initialization flag")?;
         let mut restored = Self {
             params,
             inputs,
@@ -433,13 +413,13 @@ impl Fmi2Model for Plant {
             // of the state.
             session: self.session.clone(),
             built: None,
-            start_time: self.start_time,
+            start_time,
         };
         let mut loaded = None;
-        if r.take(1)?[0] == 1 {
-            let origin = r.string()?;
-            let text = r.string()?;
-            let world_bytes = r.bytes()?;
+        if r.flag("the loaded flag")? {
+            let origin = r.string("the scenario origin")?;
+            let text = r.string("the scenario text")?;
+            let world_bytes = r.bytes("the world state")?;
             let file = ScenarioFile::parse(origin, text)?;
             let config = restored.params.world_config(&file.scenario);
             let mut world =
@@ -449,15 +429,24 @@ impl Fmi2Model for Plant {
             restored.built = Some(Built { world, log_info });
             loaded = Some(file);
         }
+        r.finish()?;
         restored.session.restore(scenario_parameter, loaded);
-        if r.pos != bytes.len() {
-            return Err(format!(
-                "TowingPlant state has {} trailing bytes",
-                bytes.len() - r.pos
-            ));
-        }
         *self = restored;
         Ok(())
+    }
+
+    fn restore_state(&mut self, _log: &Logger, saved: &Self) -> Result<(), String> {
+        let mut session = std::mem::take(&mut self.session);
+        session.restore_from(&saved.session);
+        self.clone_from(saved);
+        self.session = session;
+        Ok(())
+    }
+
+    /// The start time plus the world's time (the sum of the steps taken), once a scenario
+    /// is loaded.
+    fn time(&self) -> Option<f64> {
+        self.world().map(|w| self.start_time + w.time())
     }
 }
 
@@ -488,56 +477,5 @@ fn real_output(world: Option<&World>, c: ContractVariable) -> Option<f64> {
             read(&|w| field.of(&w.obstacle(slot.index())).unwrap_or(f64::NAN))
         }
         _ => None,
-    }
-}
-
-fn put_str(out: &mut Vec<u8>, s: &str) {
-    put_bytes(out, s.as_bytes());
-}
-
-fn put_bytes(out: &mut Vec<u8>, b: &[u8]) {
-    out.extend_from_slice(&(b.len() as u64).to_le_bytes());
-    out.extend_from_slice(b);
-}
-
-/// Bounds-checked little-endian reader for [`Plant::deserialize_state`].
-struct Reader<'a> {
-    bytes: &'a [u8],
-    pos: usize,
-}
-
-impl<'a> Reader<'a> {
-    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
-        let end = self
-            .pos
-            .checked_add(n)
-            .filter(|&e| e <= self.bytes.len())
-            .ok_or_else(|| {
-                format!(
-                    "TowingPlant state is truncated: needs {n} more bytes at offset {}",
-                    self.pos
-                )
-            })?;
-        let s = &self.bytes[self.pos..end];
-        self.pos = end;
-        Ok(s)
-    }
-
-    fn array<const N: usize>(&mut self) -> Result<[u8; N], String> {
-        let mut a = [0u8; N];
-        a.copy_from_slice(self.take(N)?);
-        Ok(a)
-    }
-
-    fn bytes(&mut self) -> Result<&'a [u8], String> {
-        let n = u64::from_le_bytes(self.array()?);
-        let n = usize::try_from(n).map_err(|_| "TowingPlant state length overflows".to_owned())?;
-        self.take(n)
-    }
-
-    fn string(&mut self) -> Result<String, String> {
-        let b = self.bytes()?;
-        String::from_utf8(b.to_vec())
-            .map_err(|_| "TowingPlant state holds invalid UTF-8".to_owned())
     }
 }

@@ -402,16 +402,7 @@ fn fmu_state_and_serialization_reproduce_a_trajectory_exactly() {
     // A fresh instance that never saw the scenario restores everything from the bytes.
     let fresh = Fmu::try_new(exports(), &DESCRIPTION, "fresh", None, false).unwrap();
     assert_eq!(fresh.setup(0.0, None), Fmi2Status::Ok);
-    let (status, state) = fresh.deserialize(&bytes);
-    assert_eq!(status, Fmi2Status::Ok, "{}", fresh.log_text());
-    // SAFETY: `state` was just deserialized by this instance and is freed once.
-    assert_eq!(
-        unsafe { fresh.set_state(state) },
-        Fmi2Status::Ok,
-        "{}",
-        fresh.log_text()
-    );
-    unsafe { fresh.free_state(state) };
+    fresh.restore(&bytes);
     let (third, _) = run(&fresh, t, 200);
     assert_eq!(bits(&first), bits(&third));
 }
@@ -551,4 +542,82 @@ fn instances_on_many_threads_match_a_sequential_run() {
     for h in handles {
         assert!(h.join().unwrap() == reference);
     }
+}
+
+/// Issue 15, item 8: a serialized state carries a CRC-32, so no single flipped bit is
+/// accepted (there were 1,560 of 3,100); each is refused with fmi2Error and a reason, and
+/// the instance goes on from where it was.
+#[test]
+fn every_single_bit_flip_of_a_serialized_state_is_refused() {
+    let fmu = plant("flips");
+    fmu.init(0.0, None);
+    pull(&fmu);
+    let (_, t) = run(&fmu, 0.0, 30);
+    let bytes = fmu.serialize();
+    let reference = plant("reference");
+    reference.init(0.0, None);
+    pull(&reference);
+    run(&reference, 0.0, 30);
+
+    fmu.clear();
+    let mut flipped = bytes.clone();
+    flipped[bytes.len() / 2] ^= 4;
+    assert_eq!(fmu.deserialize(&flipped).0, Fmi2Status::Error);
+    testing::assert_last_message_contains(&fmu, "fmi2DeSerializeFMUstate: checksum mismatch");
+    assert_eq!(
+        fmi2_slave::testing::accepted_bit_flips(&fmu, &bytes),
+        0,
+        "of {} bits",
+        8 * bytes.len()
+    );
+    // Still stepping, from where it was.
+    let (ours, _) = run(&fmu, t, 20);
+    let (theirs, _) = run(&reference, t, 20);
+    assert_eq!(bits(&ours), bits(&theirs));
+}
+
+/// Issue 15, item 8: a state whose checksum is right but whose content makes no sense is
+/// refused by name: a time shifted by 1 s, a time counter of 2^63 - 1 ns, a stored fatal
+/// or error call state.
+#[test]
+fn a_state_with_a_wrong_time_or_a_fatal_status_is_refused() {
+    use fmi2_slave::testing::forge_state;
+    use fmi2_slave::CallState;
+    let fmu = plant("forged");
+    fmu.init(0.0, None);
+    pull(&fmu);
+    run(&fmu, 0.0, 30);
+    let bytes = fmu.serialize();
+    type Edit = Box<dyn Fn(&mut fmi2_slave::testing::ForgedLayer)>;
+    let cases: [(&str, Edit); 4] = [
+        (
+            "does not match the clock's 4 s",
+            Box::new(|l| l.time_ns += 1_000_000_000),
+        ),
+        (
+            "does not match the clock's 9223372036.854776 s",
+            Box::new(|l| l.time_ns = i64::MAX),
+        ),
+        (
+            "records the call state fatal",
+            Box::new(|l| l.call_state = CallState::Fatal),
+        ),
+        (
+            "records the call state error",
+            Box::new(|l| l.call_state = CallState::Error),
+        ),
+    ];
+    for (reason, edit) in cases {
+        let forged = forge_state(&bytes, &DESCRIPTION, |l| edit(l)).unwrap();
+        let (status, state) = fmu.deserialize(&forged);
+        assert_eq!(status, Fmi2Status::Error, "{reason}");
+        assert!(state.is_null());
+        testing::assert_last_message_contains(&fmu, reason);
+    }
+    // The unforged state is fine, and the instance still steps.
+    let (status, state) = fmu.deserialize(&bytes);
+    assert_eq!(status, Fmi2Status::Ok, "{}", fmu.log_text());
+    // SAFETY: just made by this instance, freed once.
+    unsafe { fmu.free_state(state) };
+    assert_eq!(fmu.step(3.0, 0.1), Fmi2Status::Ok, "{}", fmu.log_text());
 }

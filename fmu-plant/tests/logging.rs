@@ -311,3 +311,80 @@ fn a_log_that_cannot_be_written_is_an_error_at_exit_initialization() {
         "{text}"
     );
 }
+
+/// Regression (issue 15, item 8): `fmi2SetFMUstate` with a state of another instance moved
+/// the instance onto that instance's log file. The log is not part of the state: each
+/// instance writes its own file to its own end.
+#[test]
+fn set_fmu_state_keeps_the_instance_s_own_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let (path_a, path_b) = (dir.path().join("a.mcap"), dir.path().join("b.mcap"));
+    let a = plant_logging_to("a", &path_a);
+    let b = plant_logging_to("b", &path_b);
+    for fmu in [&a, &b] {
+        fmu.init(0.0, None);
+        pull(fmu);
+    }
+    let t = steps(&a, 0.0, 50);
+    b.restore(&a.serialize());
+    let end = steps(&b, t, 50);
+    // And a state taken of `b` set on `a` (in memory, as the layer keeps it).
+    let in_memory = b.get_state();
+    // SAFETY: a live state of `b`; the layer recognises it as one of this model.
+    assert_eq!(unsafe { a.set_state(in_memory) }, Fmi2Status::Ok);
+    unsafe { b.free_state(in_memory) };
+    let end_a = steps(&a, end, 10);
+    for fmu in [&a, &b] {
+        assert_eq!(fmu.terminate(), Fmi2Status::Ok, "{}", fmu.log_text());
+    }
+    let last = |p: &Path| read_log_messages(&std::fs::read(p).unwrap()).1;
+    assert_eq!(last(&path_b), (end * 1e9).round() as u64);
+    assert_eq!(last(&path_a), (end_a * 1e9).round() as u64);
+    let ship_b = read_log_messages(&std::fs::read(&path_b).unwrap()).0;
+    // b: 0 s, its first step was not logged (it jumped to 5 s), then 5.1 ..= 10 s.
+    assert_eq!(ship_b[names::PLANT_SHIP].len(), 1 + 50);
+}
+
+/// The indexes of the steps that did not return fmi2OK in 150 steps of 0.1 s of `fmu`,
+/// whose log breaks after initialization (writes beyond the file's size then fail), and
+/// the log text.
+fn statuses_after_the_log_breaks(fmu: &Fmu, path: &Path) -> (Vec<(usize, Fmi2Status)>, String) {
+    fmu.init(0.0, None);
+    pull(fmu);
+    testing::limit_file_size(Some(std::fs::metadata(path).unwrap().len()));
+    let statuses = (0..150).map(|k| fmu.step(k as f64 * 0.1, 0.1));
+    let odd = statuses
+        .enumerate()
+        .filter(|(_, s)| *s != Fmi2Status::Ok)
+        .collect();
+    let text = fmu.log_text();
+    assert_eq!(fmu.terminate(), Fmi2Status::Error);
+    testing::assert_last_message_contains(fmu, "the file is incomplete");
+    testing::limit_file_size(None);
+    (odd, text)
+}
+
+/// Regression (issue 15, item 8): a log write that fails during the run was reported
+/// after a delay that depended on the writer thread's timing, often only at terminate.
+/// Now the step after the one whose messages failed returns fmi2Warning, every run: the
+/// log's writes fail from the end of initialization on (a file size limit in a process of
+/// its own); the first write to the file comes when the chunk holding 0..10 s is flushed,
+/// with the message at 10.0 s (the step with index 99), so the step with index 100
+/// reports it, in each of 3 runs.
+#[test]
+fn a_log_write_failure_is_reported_by_the_next_step_every_time() {
+    if !testing::rerun_in_child("a_log_write_failure_is_reported_by_the_next_step_every_time") {
+        return;
+    }
+    for run in 0..3 {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("limited.mcap");
+        let fmu = plant_logging_to("limited", &path);
+        let (odd, text) = statuses_after_the_log_breaks(&fmu, &path);
+        assert_eq!(odd, [(100, Fmi2Status::Warning)], "run {run}: {text}");
+        assert!(
+            text.contains("logging stopped") && text.contains("File too large"),
+            "{text}"
+        );
+    }
+}

@@ -12,7 +12,9 @@
 //!    `fmi2Fatal`.
 //!
 //! Every `fmi2Error` puts the instance into the `error` state, every `fmi2Fatal` into
-//! `fatal` (FMI 2.0 section 2.1.3).
+//! `fatal` (FMI 2.0 section 2.1.3), except a refusal by the functions that only read FMU
+//! states or make one from bytes ([`Func::refusal_keeps_state`]): bad bytes do not touch the
+//! instance, which goes on from where it was.
 
 #![allow(clippy::missing_safety_doc)] // safety contract documented once, on the module
 
@@ -147,10 +149,21 @@ impl<M: Fmi2Model> Instance<M> {
         })
     }
 
-    fn serialize_into(&self, layer: &LayerState, model: &M, out: &mut Vec<u8>) {
-        serial::encode(out, &self.desc.model_identifier, &self.guid, layer, |o| {
-            model.serialize_state(o)
-        });
+    /// The serialized FMU state of `layer` and `model` (format: [`serial`]).
+    fn serialize(&self, layer: &LayerState, model: &M) -> Result<Vec<u8>, String> {
+        layer.check_continuable()?;
+        let mut result = Ok(());
+        let mut out = Vec::new();
+        serial::encode(
+            &mut out,
+            &self.desc.model_identifier,
+            &self.guid,
+            layer,
+            |o| {
+                result = model.serialize_state(o);
+            },
+        );
+        result.map(|()| out)
     }
 }
 
@@ -328,7 +341,9 @@ where
         Ok(Ok(status)) => status,
         Ok(Err(msg)) => {
             inst.logger.error(&format!("{}: {msg}", func.name()));
-            inst.enter_error();
+            if !func.refusal_keeps_state() {
+                inst.enter_error();
+            }
             Fmi2Status::Error
         }
         Err(payload) => {
@@ -994,14 +1009,15 @@ pub unsafe fn get_fmu_state<M: Fmi2Model>(
     }
 }
 
-/// `fmi2SetFMUstate` (FMI 2.0 section 2.1.8): restores model and layer state.
+/// `fmi2SetFMUstate` (FMI 2.0 section 2.1.8): restores model and layer state; the model
+/// keeps what is the instance's own ([`Fmi2Model::restore_state`]).
 pub unsafe fn set_fmu_state<M: Fmi2Model>(c: Fmi2Component, fmu_state: Fmi2FmuState) -> Fmi2Status {
     // SAFETY: forwarded FMI contract.
     unsafe {
         guard::<M, _>(c, Func::SetFmuState, |inst| {
             require_state_capability::<M>(false)?;
             let b = state_box_mut::<M>(fmu_state)?;
-            inst.model.clone_from(&b.model);
+            inst.model.restore_state(&inst.logger, &b.model)?;
             inst.layer = b.layer;
             Ok(Fmi2Status::Ok)
         })
@@ -1044,9 +1060,7 @@ pub unsafe fn serialized_fmu_state_size<M: Fmi2Model>(
             let b = state_box_mut::<M>(fmu_state)?;
             let size = out_ref(size, "size")?;
             if b.serialized.is_none() {
-                let mut out = Vec::new();
-                inst.serialize_into(&b.layer, &b.model, &mut out);
-                b.serialized = Some(out);
+                b.serialized = Some(inst.serialize(&b.layer, &b.model)?);
             }
             *size = b.serialized.as_ref().map_or(0, Vec::len);
             Ok(Fmi2Status::Ok)
@@ -1068,9 +1082,7 @@ pub unsafe fn serialize_fmu_state<M: Fmi2Model>(
             require_state_capability::<M>(true)?;
             let b = state_box_mut::<M>(fmu_state)?;
             if b.serialized.is_none() {
-                let mut out = Vec::new();
-                inst.serialize_into(&b.layer, &b.model, &mut out);
-                b.serialized = Some(out);
+                b.serialized = Some(inst.serialize(&b.layer, &b.model)?);
             }
             let bytes = b.serialized.as_deref().unwrap_or_default();
             if size != bytes.len() {
@@ -1086,9 +1098,11 @@ pub unsafe fn serialize_fmu_state<M: Fmi2Model>(
     }
 }
 
-/// `fmi2DeSerializeFMUstate` (FMI 2.0 section 2.1.8): checks magic, format version, model
-/// identifier, GUID and length, then lets the model read its part into a copy of this
-/// instance's model. Writes a new FMU state to `*FMUstate` (or overwrites a non-NULL one).
+/// `fmi2DeSerializeFMUstate` (FMI 2.0 section 2.1.8): checks magic, format version,
+/// checksum, model identifier, GUID, lengths and the layer state's sense ([`serial`]), lets
+/// the model read its part into a copy of this instance's model, and checks the model's
+/// time against the clock. Writes a new FMU state to `*FMUstate` (or overwrites a non-NULL
+/// one); on any error neither the instance nor `*FMUstate` changes.
 pub unsafe fn de_serialize_fmu_state<M: Fmi2Model>(
     c: Fmi2Component,
     serialized_state: *const Fmi2Byte,
@@ -1112,6 +1126,7 @@ pub unsafe fn de_serialize_fmu_state<M: Fmi2Model>(
             model
                 .deserialize_state(&inst.logger, model_bytes)
                 .map_err(|e| format!("model state: {e}"))?;
+            serial::check_model_time(&layer, model.time())?;
             match existing {
                 Some(b) => {
                     b.layer = layer;

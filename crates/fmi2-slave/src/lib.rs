@@ -38,11 +38,14 @@
 //!   `round(h * 1e9)`, so long runs do not drift; `fmi2DoStep` checks the master's
 //!   communication point against it with tolerance `1e-5 * max(1, |t|)`.
 //! * **FMU state** (section 2.1.8) — `fmi2GetFMUstate` boxes a clone of the model plus the
-//!   layer state. The serialized form is versioned, pointer-free, little-endian:
-//!   magic `RSFMI2ST`, format version, model identifier, GUID, layer state, then the model's
-//!   own bytes ([`Fmi2Model::serialize_state`]) with a length prefix; deserialization checks
-//!   each part and names the one that does not match. It works across processes and into a
-//!   freshly instantiated instance.
+//!   layer state; `fmi2SetFMUstate` restores it with [`Fmi2Model::restore_state`], which
+//!   keeps what is the instance's own (its log). The serialized form is versioned,
+//!   pointer-free, little-endian: magic `RSFMI2ST`, format version, model identifier, GUID,
+//!   layer state, the model's own bytes ([`Fmi2Model::serialize_state`], written with
+//!   [`codec`]) with a length prefix, and a CRC-32; deserialization checks each part, that
+//!   the state makes sense (a call state to continue from, finite times, the model's time
+//!   equal to the clock's) and names what does not, leaving the instance as it was. It
+//!   works across processes and into a freshly instantiated instance.
 //! * **Logging** ([`Logger`]) — through the master's variadic callback with format `"%s"`;
 //!   warnings and errors are always sent, info messages only when logging is on and their
 //!   category (from [`ModelDescription::log_categories`]) is enabled.
@@ -51,6 +54,7 @@
 
 #![warn(missing_docs)]
 
+pub mod codec;
 pub mod description;
 pub mod doc;
 mod exports;
@@ -192,13 +196,34 @@ pub trait Fmi2Model: Clone + Send + Sized + 'static {
     fn release(&mut self, _log: &Logger) {}
 
     /// Append the model's state as pointer-free bytes with the model's own versioning
-    /// (`fmi2SerializeFMUstate`).
-    fn serialize_state(&self, out: &mut Vec<u8>);
+    /// (`fmi2SerializeFMUstate`), built with [`codec`]. `Err` (a value that cannot be
+    /// restored, such as a NaN) refuses the serialization with `fmi2Error`.
+    fn serialize_state(&self, out: &mut Vec<u8>) -> Result<(), String>;
 
     /// Restore from bytes written by [`serialize_state`](Self::serialize_state), possibly in
     /// another process. Called on a clone of a live (possibly freshly instantiated)
-    /// instance.
+    /// instance; the result becomes an FMU state that [`restore_state`](Self::restore_state)
+    /// later applies. Check everything that can be checked here (the layer has checked the
+    /// checksum, its own part and nothing else): an `Err` is `fmi2Error` from
+    /// `fmi2DeSerializeFMUstate` with the instance unchanged.
     fn deserialize_state(&mut self, log: &Logger, bytes: &[u8]) -> Result<(), String>;
+
+    /// `fmi2SetFMUstate` (FMI 2.0 section 2.1.8): become `saved` (a copy made by
+    /// `fmi2GetFMUstate`, or [`deserialize_state`](Self::deserialize_state)'s result), keeping
+    /// what belongs to the instance and not to its state, such as an open log file: the
+    /// instance goes on writing its own log. Default: a plain copy. An `Err` is `fmi2Error`;
+    /// leave `self` unchanged then.
+    fn restore_state(&mut self, _log: &Logger, saved: &Self) -> Result<(), String> {
+        self.clone_from(saved);
+        Ok(())
+    }
+
+    /// The model's own time (s), the end of its last step (the start time before the
+    /// first), if it keeps one. A deserialized state is refused when this differs from the
+    /// layer's clock by more than 1 us. Default: `None`, not checked.
+    fn time(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// Defines the 34 FMI 2.0 Co-Simulation functions (`fmi2GetTypesPlatform` …

@@ -209,6 +209,19 @@ impl Func {
         }
     }
 
+    /// Whether an `fmi2Error` of this function leaves the call state as it was: the
+    /// functions that only serialize an FMU state or make one from bytes. They do not touch
+    /// the instance's model or clock, so refusing corrupt bytes (or a state that cannot be
+    /// serialized) leaves the instance as usable as before, which is what a master that
+    /// tries a stored file needs; FMI 2.0 section 2.1.3 asks for a restart from a stored
+    /// state after an error of the instance's own computation, which this is not.
+    pub(crate) fn refusal_keeps_state(self) -> bool {
+        matches!(
+            self,
+            Func::SerializedFmuStateSize | Func::SerializeFmuState | Func::DeSerializeFmuState
+        )
+    }
+
     pub(crate) fn allowed_in(self, state: CallState) -> bool {
         self.mask() & state.bit() != 0
     }

@@ -526,6 +526,17 @@ impl Fmu {
         bytes
     }
 
+    /// Restores serialized bytes: `fmi2DeSerializeFMUstate`, `fmi2SetFMUstate`,
+    /// `fmi2FreeFMUstate`, each expected OK.
+    pub fn restore(&self, bytes: &[u8]) {
+        let (status, s) = self.deserialize(bytes);
+        assert_eq!(status, Fmi2Status::Ok, "{}", self.log_text());
+        // SAFETY: just made by this instance, freed once.
+        let set = unsafe { (self.exports.set_fmu_state)(self.c, s) };
+        assert_eq!(set, Fmi2Status::Ok, "{}", self.log_text());
+        unsafe { self.free_state(s) };
+    }
+
     /// `fmi2DeSerializeFMUstate` into a new state; the status and the state (NULL on error).
     pub fn deserialize(&self, bytes: &[u8]) -> (Fmi2Status, Fmi2FmuState) {
         let mut s: Fmi2FmuState = ptr::null_mut();
@@ -534,6 +545,69 @@ impl Fmu {
         };
         (status, s)
     }
+}
+
+/// The layer's fields of a serialized FMU state that [`forge_state`] lets a test change.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ForgedLayer {
+    /// The call state.
+    pub call_state: crate::CallState,
+    /// The start time (s).
+    pub start_time: f64,
+    /// The clock: nanoseconds since the start time.
+    pub time_ns: i64,
+}
+
+/// `bytes` (a state serialized by an FMU of `description`) with the layer's fields changed
+/// by `edit` and a valid checksum: a state that only the layer's and the model's checks
+/// of sense can refuse. `None` when `bytes` do not parse.
+pub fn forge_state(
+    bytes: &[u8],
+    description: &ModelDescription,
+    edit: impl FnOnce(&mut ForgedLayer),
+) -> Option<Vec<u8>> {
+    let guid = description.guid();
+    let id = &description.model_identifier;
+    let (mut layer, model) = crate::serial::parse(bytes, id, &guid).ok()?;
+    let mut fields = ForgedLayer {
+        call_state: layer.call_state,
+        start_time: layer.start_time,
+        time_ns: layer.time_ns,
+    };
+    edit(&mut fields);
+    layer.call_state = fields.call_state;
+    layer.start_time = fields.start_time;
+    layer.time_ns = fields.time_ns;
+    let mut out = Vec::new();
+    crate::serial::encode(&mut out, id, &guid, &layer, |o| o.extend_from_slice(model));
+    Some(out)
+}
+
+/// Flips every single bit of `bytes` in turn and deserializes each result with `fmu`;
+/// returns how many were accepted (each accepted state is freed). The log is cleared as it
+/// goes; every refusal must be `fmi2Error` with a NULL state.
+pub fn accepted_bit_flips(fmu: &Fmu, bytes: &[u8]) -> usize {
+    let mut accepted = 0;
+    let mut flipped = bytes.to_vec();
+    for bit in 0..8 * bytes.len() {
+        let (byte, mask) = (bit / 8, 1u8 << (bit % 8));
+        flipped[byte] ^= mask;
+        let (status, state) = fmu.deserialize(&flipped);
+        flipped[byte] ^= mask;
+        if status == Fmi2Status::Ok {
+            accepted += 1;
+            // SAFETY: just made by this instance, freed once.
+            unsafe { fmu.free_state(state) };
+        } else {
+            assert_eq!(status, Fmi2Status::Error, "bit {bit}");
+            assert!(state.is_null(), "bit {bit}");
+        }
+        if bit % 1024 == 0 {
+            fmu.clear();
+        }
+    }
+    fmu.clear();
+    accepted
 }
 
 impl Drop for Fmu {

@@ -24,6 +24,8 @@
 
 use std::time::{Duration, Instant};
 
+use serde::{Deserialize, Serialize};
+
 use towing_guidance::{
     body_to_ned, role, ActiveObstacle, GuidanceOutput, GuidanceParams, ReferenceSystem, Role,
     Situation, TowState,
@@ -33,8 +35,8 @@ use towing_model::{
 };
 use towing_mpc::{
     Admm, AdmmBuildError, AppliedCommand, Budget, Centralized, FormationMap, Obstacle, Optimizer,
-    PredictionHull, QpOutcome, SampleInput, ShipInput, ShipModel, ShipMpc, TugInput, TugModel,
-    TugMpc, HORIZON,
+    OptimizerState, PredictionHull, QpOutcome, SampleInput, ShipInput, ShipModel, ShipMpc,
+    TugInput, TugModel, TugMpc, HORIZON,
 };
 
 use crate::config::{Architecture, ControllerConfig, InnerLoopParams};
@@ -42,7 +44,7 @@ use crate::error::{ConfigError, MeasurementError};
 use crate::mpc_input::MpcInput;
 
 /// What the controller reads every step: the plant's outputs.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Measurement {
     /// Ship `[x, y, psi, u, v, r]` (NED pose, body velocity).
     pub ship: [f64; 6],
@@ -110,7 +112,7 @@ impl Measurement {
 }
 
 /// The plant's inputs.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Command {
     /// `tau_Ti = [X, Y, N]` per tug (N, N, N m, tug body frame).
     pub tug_thrust: [[f64; 3]; 2],
@@ -216,7 +218,7 @@ const SAMPLE_TOLERANCE_NS: i64 = 1_000;
 
 /// The sampling clock of [`Controller::step`], in whole nanoseconds since the
 /// start time.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 struct Clock {
     start: Option<f64>,
     sample_ns: i64,
@@ -248,6 +250,33 @@ impl std::fmt::Display for Fallback {
             Fallback::NonFinitePlan => write!(f, "the plan is not finite"),
         }
     }
+}
+
+/// Everything a [`Controller`] carries from one step to the next that decides its later
+/// commands and reports, and nothing it can rebuild from its configuration: what a
+/// controller's FMU state holds ([`Controller::snapshot`], [`Controller::restore`]). Serde
+/// writes it; every float in it is finite.
+///
+/// In: the guidance's memory (active waypoint, encounters, situations), the optimizer's
+/// warm start ([`OptimizerState`]: plans, ADMM multipliers, trust radii), the applied
+/// command, the fallback's spare plan, the inner loop's velocity ramp, the fallback
+/// count, the port-turn anchors and the sample clock. Not in: the configuration, the
+/// solvers (QPs, factorisations, linearisations, buffers), the inner-loop gains and
+/// thrust limits (all rebuilt from the configuration), the MPC obstacle list and the last
+/// MPC input (both written by a sample before they are read).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ControllerState {
+    guidance: ReferenceSystem,
+    optimizer: OptimizerState,
+    applied: AppliedCommand,
+    spare_ship: [ShipInput; HORIZON],
+    spare_tugs: [[TugInput; HORIZON]; 2],
+    spare_left: usize,
+    nu_start: [[f64; 3]; 2],
+    nu_end: [[f64; 3]; 2],
+    fallbacks: u64,
+    port_turn_anchor: [Option<f64>; MAX_OBSTACLES],
+    clock: Clock,
 }
 
 /// The controller (module docs).
@@ -347,6 +376,81 @@ impl Controller {
             },
             last_input: None,
         })
+    }
+
+    /// The state to carry over ([`ControllerState`]). The destructuring names every
+    /// field, so a field added to the controller has to be placed in or out of it.
+    #[must_use]
+    pub fn snapshot(&self) -> ControllerState {
+        let Controller {
+            config: _,
+            guidance,
+            solver,
+            inner_k: _,
+            thrust_limit: _,
+            applied,
+            spare_ship,
+            spare_tugs,
+            spare_left,
+            nu_start,
+            nu_end,
+            fallbacks,
+            mpc_obstacles: _,
+            port_turn_anchor,
+            clock,
+            last_input: _,
+        } = self;
+        ControllerState {
+            guidance: guidance.clone(),
+            optimizer: solver.snapshot(),
+            applied: *applied,
+            spare_ship: *spare_ship,
+            spare_tugs: *spare_tugs,
+            spare_left: *spare_left,
+            nu_start: *nu_start,
+            nu_end: *nu_end,
+            fallbacks: *fallbacks,
+            port_turn_anchor: *port_turn_anchor,
+            clock: *clock,
+        }
+    }
+
+    /// Goes on from `state`, a [`snapshot`](Self::snapshot) of a controller with the same
+    /// configuration (possibly in another process): the next steps give the commands
+    /// and reports, bit for bit, that the snapshot's controller would have given.
+    ///
+    /// # Errors
+    /// A state that does not fit this controller (another architecture or sample time,
+    /// a waypoint outside the route, a plan of another size), named; nothing changes
+    /// then.
+    pub fn restore(&mut self, state: &ControllerState) -> Result<(), String> {
+        if state.clock.sample_ns != self.clock.sample_ns {
+            return Err(format!(
+                "the state's sample time is {} ns, this controller's {} ns",
+                state.clock.sample_ns, self.clock.sample_ns
+            ));
+        }
+        if state.spare_left >= HORIZON {
+            return Err(format!(
+                "{} samples left in the spare plan, at most {} possible",
+                state.spare_left,
+                HORIZON - 1
+            ));
+        }
+        let mut guidance = self.guidance.clone();
+        guidance.restore(&state.guidance)?;
+        self.solver.restore(&state.optimizer)?;
+        self.guidance = guidance;
+        self.applied = state.applied;
+        self.spare_ship = state.spare_ship;
+        self.spare_tugs = state.spare_tugs;
+        self.spare_left = state.spare_left;
+        self.nu_start = state.nu_start;
+        self.nu_end = state.nu_end;
+        self.fallbacks = state.fallbacks;
+        self.port_turn_anchor = state.port_turn_anchor;
+        self.clock = state.clock;
+        Ok(())
     }
 
     /// The configuration.

@@ -318,9 +318,17 @@ pub struct GuidanceOutput {
 /// assert!((out.eta_sd.psi - 116.3f64.to_radians()).abs() < 1e-9); // 101.3 + 15 deg
 /// # Ok::<(), towing_guidance::InputError>(())
 /// ```
-#[derive(Debug, Clone)]
+///
+/// Serde writes what the system remembers between samples, every field but the route and
+/// the parameters (which come from the configuration): the memory of a controller's FMU
+/// state. A deserialized value carries a placeholder route and parameters and only serves
+/// [`ReferenceSystem::restore`]. A field added here is part of that memory unless it is
+/// marked `#[serde(skip)]` too.
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ReferenceSystem {
+    #[serde(skip, default = "Route::paper")]
     route: Route,
+    #[serde(skip)]
     params: GuidanceParams,
     active: usize,
     latched: u64,
@@ -342,6 +350,28 @@ impl ReferenceSystem {
             held: [None; MAX_OBSTACLES],
             situations: [None; MAX_OBSTACLES],
         }
+    }
+
+    /// Takes the memory of `saved` (every field but the route and the parameters: the
+    /// active waypoint and the encounters), keeping this system's route and parameters:
+    /// restoring a controller's FMU state.
+    ///
+    /// # Errors
+    /// An active waypoint outside this route (nothing changes then).
+    pub fn restore(&mut self, saved: &ReferenceSystem) -> Result<(), String> {
+        let n = self.route.points().len();
+        if !(1..n).contains(&saved.active) {
+            return Err(format!(
+                "guidance: active waypoint {} is not in 1..{n} of the route",
+                saved.active
+            ));
+        }
+        *self = ReferenceSystem {
+            route: self.route.clone(),
+            params: self.params,
+            ..saved.clone()
+        };
+        Ok(())
     }
 
     /// Back to the start of the route, no encounter.

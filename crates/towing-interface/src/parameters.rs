@@ -173,6 +173,35 @@ pub fn values_json<T>(
         .collect()
 }
 
+/// The value of every parameter of `registry` in `of`, in the registry's order: the
+/// parameters' part of an FMU state, restored by [`from_values`].
+#[must_use]
+pub fn values<T>(registry: &[Parameter<T>], of: &T) -> Vec<Value> {
+    registry.iter().map(|p| p.get(of)).collect()
+}
+
+/// The defaults of `registry` with `values` (from [`values`]) set, each checked as when a
+/// master sets it.
+///
+/// # Errors
+/// Another number of values than parameters, or a value the parameter refuses (named).
+pub fn from_values<T: Default>(registry: &[Parameter<T>], values: &[Value]) -> Result<T, String> {
+    if values.len() != registry.len() {
+        return Err(format!(
+            "{} parameter values, the registry has {} parameters",
+            values.len(),
+            registry.len()
+        ));
+    }
+    let mut out = T::default();
+    for (p, v) in registry.iter().zip(values) {
+        p.check(v)
+            .and_then(|()| p.set(&mut out, v.clone()))
+            .map_err(|e| format!("parameter `{}`: {}", e.field, e.reason))?;
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {

@@ -8,6 +8,7 @@
 use crate::scenario::ScenarioFile;
 use fmi2_slave::Logger;
 use std::path::{Path, PathBuf};
+use towing_log::writer::Batch;
 use towing_log::{LogError, LogOptions, LogWriter, RunInfo, SharedLog};
 use towing_model::registry::{self, Kind, Value};
 use towing_model::Scenario;
@@ -190,6 +191,14 @@ impl RunSession {
         self.loaded = loaded;
     }
 
+    /// `fmi2SetFMUstate`: takes the `scenario` parameter and the loaded scenario of
+    /// `saved` (the session of the FMU state), keeping this instance's own log, `log_file`,
+    /// `run_id` and resources folder: the log is not part of the FMU state, so an instance
+    /// goes on writing its own file whichever instance the state came from.
+    pub fn restore_from(&mut self, saved: &RunSession) {
+        self.restore(saved.scenario_parameter.clone(), saved.loaded.clone());
+    }
+
     /// The scenario as loaded: origin, text and parsed scenario.
     #[must_use]
     pub fn loaded(&self) -> Option<&ScenarioFile> {
@@ -247,6 +256,20 @@ impl RunSession {
     #[must_use]
     pub fn log(&self) -> &SharedLog {
         &self.log
+    }
+
+    /// At every step: hands the batch `messages` makes (called only while the log is
+    /// active; `None`: nothing to write this step) to the log, or else waits for the
+    /// messages of earlier steps. Returns a logging failure not reported yet, once, for the
+    /// FMU to report as `fmi2Warning`: the failure of a step's messages comes back at the
+    /// next step, whatever the writer thread's timing ([`SharedLog::batch`]).
+    pub fn log_step(&self, messages: impl FnOnce() -> Option<Batch>) -> Option<String> {
+        if self.log.is_active() {
+            if let Some(batch) = messages() {
+                return self.log.batch(batch);
+            }
+        }
+        self.log.settle()
     }
 
     /// `fmi2Terminate`: finishes the log.

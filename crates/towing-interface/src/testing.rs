@@ -324,3 +324,52 @@ pub fn assert_uncreatable_log_file_is_named(fmu: &Fmu, path: &str) {
         "{text}"
     );
 }
+
+/// Set in the child process of [`rerun_in_child`].
+const CHILD: &str = "TOWING_TEST_CHILD";
+
+/// For a test that needs a process of its own (one whose file size is limited,
+/// [`limit_file_size`]): in the test's own process, runs the test `name` (its path in the
+/// test binary, e.g. `a_log_write_failure_is_reported_by_the_next_step_every_time`) again
+/// in a child process of the same binary, asserts that it passed and returns `false`; in
+/// the child, returns `true`, and the test does its work. The child ignores SIGXFSZ, so a
+/// write beyond the limit fails with EFBIG instead of killing it.
+#[must_use]
+pub fn rerun_in_child(name: &str) -> bool {
+    if std::env::var_os(CHILD).is_some() {
+        return true;
+    }
+    let exe = std::env::current_exe().expect("the test binary's path");
+    let out = std::process::Command::new("sh")
+        .args(["-c", "trap '' XFSZ; exec \"$0\" \"$@\""])
+        .arg(exe)
+        .args(["--exact", name, "--nocapture", "--test-threads", "1"])
+        .env(CHILD, "1")
+        .output()
+        .expect("the test binary runs again");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.contains("1 passed"),
+        "the child run of {name} failed ({}):\n{text}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    false
+}
+
+/// Limits the size of every file this process writes to `bytes` (`None`: no limit), with
+/// `prlimit`: a write beyond it fails (EFBIG), as on a full disk. Only in a child of
+/// [`rerun_in_child`].
+pub fn limit_file_size(bytes: Option<u64>) {
+    assert!(
+        std::env::var_os(CHILD).is_some(),
+        "only in a child process of rerun_in_child"
+    );
+    let limit = bytes.map_or_else(|| "unlimited".to_owned(), |b| b.to_string());
+    let status = std::process::Command::new("prlimit")
+        .arg(format!("--pid={}", std::process::id()))
+        .arg(format!("--fsize={limit}:"))
+        .status()
+        .expect("prlimit runs");
+    assert!(status.success(), "prlimit --fsize={limit}");
+}

@@ -21,7 +21,7 @@ use std::io::BufWriter;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{sync_channel, SyncSender};
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::thread::JoinHandle;
 
 /// What can go wrong while logging; every message names the file and the reason.
@@ -573,13 +573,6 @@ impl LogWriter {
 /// run it later on its own thread.
 pub type Batch = Box<dyn FnOnce(&mut LogWriter) -> Result<(), LogError> + Send>;
 
-/// Batches handed to a writer thread at once: one wake-up of the thread per this many
-/// steps (a handful of seconds of simulated time at the usual 0.1 s step, less than the
-/// flush interval).
-const HANDOFF: usize = 16;
-/// Hand-offs a writer thread may have queued before [`SharedLog::batch`] waits for it.
-const QUEUE: usize = 64;
-
 /// What the writer side reports back.
 #[derive(Debug, Default)]
 struct Status {
@@ -625,30 +618,96 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
-/// The writer thread: the queue into it, the batches not handed over yet, and its handle
-/// (returning the finish result).
+/// Records that the writer thread ended before it was asked to (its own failure, if any,
+/// stays the one reported).
+fn stopped(status: &Mutex<Status>) {
+    lock(status)
+        .failure
+        .get_or_insert_with(|| "the log writer thread stopped".to_owned());
+}
+
+/// The failure's text, the first time it is asked for.
+fn warning_once(status: &Mutex<Status>) -> Option<String> {
+    let mut st = lock(status);
+    match &st.failure {
+        Some(message) if !st.warned => {
+            let warning = format!("logging stopped: {message}");
+            st.warned = true;
+            Some(warning)
+        }
+        _ => None,
+    }
+}
+
+/// How far the writer thread has got: batches written (or skipped after a failure), and
+/// whether the thread has ended (normally or by a panic outside a batch).
+#[derive(Debug, Default)]
+struct Progress {
+    done: u64,
+    exited: bool,
+}
+
+/// The caller's side of [`Progress`], with its signal.
+#[derive(Debug, Default)]
+struct Tracker {
+    progress: Mutex<Progress>,
+    changed: Condvar,
+}
+
+impl Tracker {
+    fn update(&self, f: impl FnOnce(&mut Progress)) {
+        f(&mut lock(&self.progress));
+        self.changed.notify_all();
+    }
+}
+
+/// Marks the thread as ended when dropped, also while it unwinds, so that a caller
+/// waiting for it never waits for ever.
+struct ExitSignal(Arc<Tracker>);
+
+impl Drop for ExitSignal {
+    fn drop(&mut self) {
+        self.0.update(|p| p.exited = true);
+    }
+}
+
+/// The writer thread: the queue into it, how many batches went in, its progress, and its
+/// handle (returning the finish result).
 struct Worker {
-    queue: SyncSender<Vec<Batch>>,
-    pending: Vec<Batch>,
+    queue: SyncSender<Batch>,
+    sent: u64,
+    tracker: Arc<Tracker>,
     handle: JoinHandle<Result<(), LogError>>,
 }
 
 impl std::fmt::Debug for Worker {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Worker")
-            .field("pending", &self.pending.len())
+            .field("sent", &self.sent)
             .finish_non_exhaustive()
     }
 }
 
 impl Worker {
-    /// Hands the pending batches to the thread; false if it is gone.
-    fn hand_off(&mut self) -> bool {
-        if self.pending.is_empty() {
-            return true;
+    /// Waits until the thread has written every batch handed to it (or has ended); false
+    /// if it ended.
+    fn settle(&self) -> bool {
+        let mut p = lock(&self.tracker.progress);
+        while p.done < self.sent && !p.exited {
+            p = self
+                .tracker
+                .changed
+                .wait(p)
+                .unwrap_or_else(PoisonError::into_inner);
         }
-        let batches = std::mem::replace(&mut self.pending, Vec::with_capacity(HANDOFF));
-        self.queue.send(batches).is_ok()
+        !p.exited
+    }
+
+    /// Hands `batch` to the thread; false if it is gone.
+    fn send(&mut self, batch: Batch) -> bool {
+        let sent = self.queue.send(batch).is_ok();
+        self.sent += u64::from(sent);
+        sent
     }
 }
 
@@ -674,11 +733,15 @@ struct Shared {
 ///
 /// Two modes: [`SharedLog::new`] runs each batch on the caller's thread;
 /// [`SharedLog::spawn`] hands the batches to a writer thread (serialization, compression
-/// and I/O off the simulation's thread, in order), 16 at a time so the thread wakes once
-/// per 16 steps, with at most 64 hand-offs queued (then the caller waits); which the FMUs
-/// use. Batches not handed over yet are lost if the process dies, like the open chunk.
-/// Either way a failure stops the log, is returned once as a warning by a later
-/// [`batch`](SharedLog::batch) and again as the error of [`finish`](SharedLog::finish).
+/// and I/O off the simulation's thread, in order), which the FMUs
+/// use. Either way a failure stops the log, is returned once as a warning and again as the
+/// error of [`finish`](SharedLog::finish). When the warning comes is fixed, whatever the
+/// threads' timing: inline, by the [`batch`](SharedLog::batch) call that failed; with the
+/// writer thread, by the next [`batch`](SharedLog::batch) or [`settle`](SharedLog::settle)
+/// call, which first waits for the thread to finish what it was given (each batch is
+/// handed over at once, so the thread writes one step while the simulation computes the
+/// next). An FMU calls one of them at every step, so a failure is reported by the step
+/// after the one whose messages failed.
 #[derive(Debug, Clone, Default)]
 pub struct SharedLog {
     inner: Option<Arc<Mutex<Shared>>>,
@@ -732,21 +795,24 @@ impl SharedLog {
     pub fn spawn(mut writer: LogWriter) -> Result<Self, LogError> {
         let path = writer.path().to_path_buf();
         let status: Arc<Mutex<Status>> = Arc::default();
-        let (tx, rx) = sync_channel::<Vec<Batch>>(QUEUE);
+        let tracker: Arc<Tracker> = Arc::default();
+        // One batch in flight: the caller waits for it before handing over the next.
+        let (tx, rx) = sync_channel::<Batch>(1);
         let thread_status = Arc::clone(&status);
+        let thread_tracker = Arc::clone(&tracker);
         let display = writer.display.clone();
         // The writer moves into the thread; if spawning fails, the closure (and the writer
         // with it) is dropped, which finishes the file as far as possible.
         let handle = std::thread::Builder::new()
             .name("towing-log".to_owned())
             .spawn(move || {
+                let exit = ExitSignal(thread_tracker);
                 let mut open = true;
-                for batches in rx {
-                    for batch in batches {
-                        if open {
-                            open = Status::run(&thread_status, &mut writer, batch);
-                        }
+                for batch in rx {
+                    if open {
+                        open = Status::run(&thread_status, &mut writer, batch);
                     }
+                    exit.0.update(|p| p.done += 1);
                 }
                 if open {
                     writer.finish()
@@ -762,7 +828,8 @@ impl SharedLog {
             path,
             Mode::Background(Some(Worker {
                 queue: tx,
-                pending: Vec::with_capacity(HANDOFF),
+                sent: 0,
+                tracker,
                 handle,
             })),
             status,
@@ -791,41 +858,51 @@ impl SharedLog {
     /// earlier FMU state, and log times must not decrease); any other error stops the log
     /// (the file is finished as far as possible and the error kept for
     /// [`finish`](Self::finish)). Returns the failure's text, once, for the FMU to report
-    /// as a warning (with a writer thread: at the batch after the one that failed).
-    /// Nothing happens without an open log.
+    /// as a warning: inline, the failure of this batch; with a writer thread, of the
+    /// batches before this one, all written before it is handed over (type docs). Nothing
+    /// happens without an open log.
     pub fn batch(&self, batch: Batch) -> Option<String> {
         let mut shared = self.lock()?;
         let Shared { mode, status, .. } = &mut *shared;
-        if lock(status).failure.is_none() {
-            match mode {
-                Mode::Inline(slot) => {
+        match mode {
+            Mode::Inline(slot) => {
+                if lock(status).failure.is_none() {
                     if let Some(writer) = slot.as_mut().filter(|w| !w.is_finished()) {
                         if !Status::run(status, writer, batch) {
                             *slot = None;
                         }
                     }
                 }
-                Mode::Background(Some(worker)) => {
-                    worker.pending.push(batch);
-                    // A send fails only if the thread is gone; its status says why.
-                    if worker.pending.len() >= HANDOFF && !worker.hand_off() {
-                        lock(status)
-                            .failure
-                            .get_or_insert_with(|| "the log writer thread stopped".to_owned());
-                    }
+                warning_once(status)
+            }
+            Mode::Background(Some(worker)) => {
+                if !worker.settle() {
+                    stopped(status);
                 }
-                Mode::Background(None) => {}
+                // Taken before this batch goes over: the thread may fail it at once, and
+                // that is for the next call to report (never sooner, never later).
+                let warning = warning_once(status);
+                if lock(status).failure.is_none() && !worker.send(batch) {
+                    stopped(status);
+                }
+                warning
+            }
+            Mode::Background(None) => warning_once(status),
+        }
+    }
+
+    /// Waits for a writer thread to write every batch handed to it and returns a failure
+    /// not reported yet, once (as [`batch`](Self::batch)): for a step that writes nothing,
+    /// so that the failure of an earlier step's messages is still reported by the next
+    /// step.
+    pub fn settle(&self) -> Option<String> {
+        let shared = self.lock()?;
+        if let Mode::Background(Some(worker)) = &shared.mode {
+            if !worker.settle() {
+                stopped(&shared.status);
             }
         }
-        let mut st = lock(status);
-        match &st.failure {
-            Some(message) if !st.warned => {
-                let warning = format!("logging stopped: {message}");
-                st.warned = true;
-                Some(warning)
-            }
-            _ => None,
-        }
+        warning_once(&shared.status)
     }
 
     /// Finishes the writer (waiting for a writer thread to write everything queued) and
@@ -845,9 +922,8 @@ impl SharedLog {
                 _ => Ok(false),
             },
             Mode::Background(b) => match b.take() {
-                Some(mut worker) => {
+                Some(worker) => {
                     // If the thread is gone, its status or the join says why.
-                    let _ = worker.hand_off();
                     let Worker { queue, handle, .. } = worker;
                     drop(queue);
                     match handle.join() {

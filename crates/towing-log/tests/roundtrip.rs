@@ -7,6 +7,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 use towing_log::scene::{self, colors};
 use towing_log::topics::{self, names, *};
+use towing_log::writer::Batch;
 use towing_log::{LogError, LogOptions, LogWriter, SharedLog, TopicMessage};
 
 fn vessel(t: f64) -> VesselState {
@@ -360,7 +361,7 @@ fn errors_name_the_file_and_the_reason() {
 }
 
 /// A batch writing the ship's state at `t`.
-fn ship_at(t: f64) -> towing_log::writer::Batch {
+fn ship_at(t: f64) -> Batch {
     Box::new(move |w| w.write(names::PLANT_SHIP, t, &vessel(t)))
 }
 
@@ -416,34 +417,34 @@ fn a_shared_log_is_one_writer_for_every_clone() {
     }
 }
 
-#[test]
-fn a_failing_disk_stops_the_log_and_finish_reports_it() {
-    // /dev/full accepts the open and refuses every write with ENOSPC.
-    if !Path::new("/dev/full").exists() {
-        return;
+/// The index of the first batch that returns a warning, and the warning.
+fn first_warning(log: &SharedLog, batches: impl Iterator<Item = Batch>) -> (usize, String) {
+    for (k, batch) in batches.enumerate() {
+        if let Some(w) = log.batch(batch) {
+            return (k, w);
+        }
     }
+    panic!("no warning")
+}
+
+#[test]
+fn a_failing_disk_stops_the_log_and_the_next_batch_reports_it() {
+    // /dev/full accepts the open and refuses every write with ENOSPC: the first batch,
+    // which writes its channel's schema, fails. Inline, that batch reports it; with a
+    // writer thread, the next one, every time (no sleeping needed).
     let options = LogOptions {
         flush_interval: 0.1,
         ..LogOptions::default()
     };
-    for background in [false, true] {
+    for (background, expected) in [(false, 0), (true, 1), (true, 1), (true, 1)] {
         let log = shared(Path::new("/dev/full"), background, options);
-        let mut warning = None;
-        for k in 0..100 {
-            warning = log.batch(ship_at(k as f64 * 0.1));
-            if warning.is_some() {
-                break;
-            }
-            if background {
-                // Let the writer thread catch up, so the failure shows within the loop.
-                std::thread::sleep(std::time::Duration::from_millis(2));
-            }
-        }
-        let warning = warning.expect("a write to /dev/full fails at the first flush");
+        let (k, warning) = first_warning(&log, (0..100).map(|k| ship_at(k as f64 * 0.1)));
+        assert_eq!(k, expected, "background {background}");
         assert!(warning.contains("/dev/full"), "{warning}");
         assert!(!log.is_active());
         // The warning is given once; later batches are ignored.
         assert_eq!(log.batch(ship_at(100.0)), None);
+        assert_eq!(log.settle(), None);
         let e = log.finish().unwrap_err();
         assert!(matches!(e, LogError::Stopped { .. }), "{e}");
         assert!(e.to_string().contains("/dev/full"), "{e}");
@@ -453,23 +454,35 @@ fn a_failing_disk_stops_the_log_and_finish_reports_it() {
 }
 
 #[test]
+fn settle_reports_a_failure_of_the_batches_before() {
+    let log = shared(
+        Path::new("/dev/full"),
+        true,
+        LogOptions {
+            flush_interval: 0.1,
+            ..LogOptions::default()
+        },
+    );
+    assert_eq!(log.batch(ship_at(0.0)), None);
+    let warning = log.settle().expect("the first batch failed");
+    assert!(warning.contains("No space left"), "{warning}");
+    assert_eq!(log.settle(), None);
+}
+
+#[test]
 fn a_panicking_batch_stops_the_log_without_unwinding_into_the_caller() {
     let dir = tempfile::tempdir().unwrap();
-    for background in [false, true] {
+    for (background, expected) in [(false, 1), (true, 2)] {
         let path = dir.path().join(format!("panic-{background}.mcap"));
         let log = shared(&path, background, LogOptions::default());
-        assert_eq!(log.batch(ship_at(0.0)), None);
-        let mut warning = log.batch(Box::new(|_| panic!("a bug in a message builder")));
-        // With a writer thread the failure shows at a later batch (batches are handed
-        // over 16 at a time).
-        for k in 1..200 {
-            if warning.is_some() {
-                break;
-            }
-            std::thread::sleep(std::time::Duration::from_millis(1));
-            warning = log.batch(ship_at(k as f64));
-        }
-        let warning = warning.expect("the panic is reported");
+        let batches = (0..10).map(|k| match k {
+            1 => Box::new(|_: &mut LogWriter| -> Result<(), LogError> {
+                panic!("a bug in a message builder")
+            }) as Batch,
+            k => ship_at(f64::from(k)),
+        });
+        let (k, warning) = first_warning(&log, batches);
+        assert_eq!(k, expected, "background {background}");
         assert!(warning.contains("a bug in a message builder"), "{warning}");
         assert!(log.finish().is_err());
         // The file was finished after the panic: its first message is readable.

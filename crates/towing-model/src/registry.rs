@@ -164,8 +164,9 @@ pub enum Kind<T: 'static> {
 }
 
 /// A parameter value, by the FMI type it is set and read with: an Enumeration's is its
-/// item's value, an [`Value::Integer`] (FMI 2.0 section 2.1.7).
-#[derive(Debug, Clone, PartialEq)]
+/// item's value, an [`Value::Integer`] (FMI 2.0 section 2.1.7). Serde writes it tagged by
+/// its type (an FMU state's parameter values).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Value {
     /// A Real.
     Real(f64),

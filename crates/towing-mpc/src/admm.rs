@@ -41,10 +41,11 @@
 
 use std::fmt;
 
+use serde::{Deserialize, Serialize};
 use towing_model::{HullModel, ParamError, Scenario};
 
 use crate::costs::angle_difference;
-use crate::engine::{Budget, ScpReport};
+use crate::engine::{Budget, ScpReport, ScpState};
 use crate::formation::FormationMap;
 use crate::obstacle::Obstacle;
 use crate::params::PredictionParams;
@@ -178,7 +179,7 @@ impl From<QpBuildError> for AdmmBuildError {
 }
 
 /// The command applied in the previous sample.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct AppliedCommand {
     /// `[F_1, F_2, alpha_1, alpha_2]`: the rate bounds (20)-(21) of the first sample.
     pub ship: ShipInput,
@@ -271,6 +272,21 @@ impl AdmmReport {
     pub fn last_step_failed(&self) -> bool {
         self.last_steps.iter().any(|r| !r.qp.is_usable())
     }
+}
+
+/// What an [`Admm`] carries from one control sample to the next (its warm start): the
+/// three subproblems' [`ScpState`]s and the multipliers. `f_prev` is not in it: each
+/// sample sets it anew before reading it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AdmmState {
+    /// The coordination problem's plan and trust radius.
+    pub ship: ScpState,
+    /// Tug 1's and tug 2's.
+    pub tugs: [ScpState; 2],
+    /// The multipliers `lambda_i`.
+    pub lambda: [[[f64; 3]; HORIZON]; 2],
+    /// Whether the next sample starts from the plans (else cold).
+    pub warm: bool,
 }
 
 /// The distributed MPC for one control sample (module docs).
@@ -389,6 +405,42 @@ impl Admm {
     #[must_use]
     pub fn lambda(&self) -> &[[[f64; 3]; HORIZON]; 2] {
         &self.lambda
+    }
+
+    /// The state to carry over ([`AdmmState`]).
+    #[must_use]
+    pub fn snapshot(&self) -> AdmmState {
+        let warm = self.warm;
+        AdmmState {
+            ship: self.ship.snapshot(warm),
+            tugs: [self.tug1.snapshot(warm), self.tug2.get().snapshot(warm)],
+            lambda: self.lambda,
+            warm,
+        }
+    }
+
+    /// Goes on from `state` (a [`snapshot`](Self::snapshot) of a loop over the same
+    /// problems).
+    ///
+    /// # Errors
+    /// A subproblem's state that does not fit, named (nothing changes then).
+    pub fn restore(&mut self, state: &AdmmState) -> Result<(), String> {
+        fn name(what: &'static str) -> impl Fn(String) -> String {
+            move |e| format!("{what}: {e}")
+        }
+        self.ship.fits(&state.ship).map_err(name("ship problem"))?;
+        self.tug1
+            .fits(&state.tugs[0])
+            .map_err(name("tug 1 problem"))?;
+        let mut tug2 = self.tug2.get_mut();
+        tug2.fits(&state.tugs[1]).map_err(name("tug 2 problem"))?;
+        tug2.restore(&state.tugs[1])?;
+        drop(tug2);
+        self.ship.restore(&state.ship)?;
+        self.tug1.restore(&state.tugs[0])?;
+        self.lambda = state.lambda;
+        self.warm = state.warm;
+        Ok(())
     }
 
     /// Next sample starts cold (module docs); trust regions back to their start.

@@ -69,13 +69,14 @@
 #![allow(clippy::needless_range_loop)]
 
 use nalgebra::{RowSVector, SMatrix};
+use serde::{Deserialize, Serialize};
 use towing_model::{HullModel, ParamError, Scenario};
 
 use crate::admm::{AdmmBuildError, SampleInput};
 use crate::costs::{angle_difference, obstacle_terms, ship_stage_terms, thrust_rate_terms};
 use crate::engine::{
     Block, BlockMut, Budget, InputSpace, Merit, PairRows, QuadModel, RowSet, Scp, ScpReport,
-    ScpSettings, SlotRows, Subproblem,
+    ScpSettings, ScpState, SlotRows, Subproblem,
 };
 use crate::formation::FormationMap;
 use crate::params::PredictionParams;
@@ -671,6 +672,15 @@ pub struct Centralized {
     warm: bool,
 }
 
+/// What a [`Centralized`] carries from one control sample to the next (its warm start).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CentralizedState {
+    /// The plan and trust radius.
+    pub scp: ScpState,
+    /// Whether the next sample starts from the plan (else cold).
+    pub warm: bool,
+}
+
 impl Centralized {
     /// The problem over the given models (`tugs[i]` must model the tug on line
     /// `i`), both tugs with `tug_params`.
@@ -785,6 +795,27 @@ impl Centralized {
     #[must_use]
     pub fn trust_region(&self) -> &crate::engine::TrustRegion {
         self.scp.trust_region()
+    }
+
+    /// The state to carry over ([`CentralizedState`]).
+    #[must_use]
+    pub fn snapshot(&self) -> CentralizedState {
+        CentralizedState {
+            scp: self.scp.snapshot(self.warm),
+            warm: self.warm,
+        }
+    }
+
+    /// Goes on from `state` (a [`snapshot`](Self::snapshot) of the same problem).
+    ///
+    /// # Errors
+    /// A plan or radius that does not fit (nothing changes then).
+    pub fn restore(&mut self, state: &CentralizedState) -> Result<(), String> {
+        self.scp
+            .restore(&state.scp)
+            .map_err(|e| format!("centralized problem: {e}"))?;
+        self.warm = state.warm;
+        Ok(())
     }
 
     /// Next sample starts cold (the previous command repeated); trust region back

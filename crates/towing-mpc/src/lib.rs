@@ -108,16 +108,19 @@ pub const HORIZON: usize = 3;
 pub(crate) use engine::condense;
 
 pub use admm::{
-    Admm, AdmmBuildError, AdmmReport, AdmmSettings, AppliedCommand, IterationRecord, SampleInput,
+    Admm, AdmmBuildError, AdmmReport, AdmmSettings, AdmmState, AppliedCommand, IterationRecord,
+    SampleInput,
 };
-pub use centralized::{Centralized, CentralizedReport, CentralizedSettings, CostBreakdown};
+pub use centralized::{
+    Centralized, CentralizedReport, CentralizedSettings, CentralizedState, CostBreakdown,
+};
 pub use costs::{angle_difference, ClearanceParams};
-pub use engine::{Budget, Merit, Scp, ScpReport, ScpSettings, Subproblem, TrustRegion};
+pub use engine::{Budget, Merit, Scp, ScpReport, ScpSettings, ScpState, Subproblem, TrustRegion};
 pub use formation::FormationMap;
 pub use hull::{JacobianMethod, PredictionHull};
 pub use lines::line_direction;
 pub use obstacle::{DistanceCost, Obstacle};
-pub use optimizer::{MpcReport, Optimizer};
+pub use optimizer::{MpcReport, Optimizer, OptimizerState};
 pub use params::PredictionParams;
 pub use qp::{Qp, QpFailure, QpOutcome};
 pub use ship::{ShipInput, ShipLinearisation, ShipModel, ShipState};

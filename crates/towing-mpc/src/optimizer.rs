@@ -3,8 +3,10 @@
 //! one control sample's plans for the ship and both tugs. The controller holds a
 //! `Box<dyn Optimizer>` and never asks which one it has.
 
-use crate::admm::{Admm, SampleInput};
-use crate::centralized::Centralized;
+use serde::{Deserialize, Serialize};
+
+use crate::admm::{Admm, AdmmState, SampleInput};
+use crate::centralized::{Centralized, CentralizedState};
 use crate::engine::Budget;
 use crate::qp::QpOutcome;
 use crate::ship::{ShipInput, ShipModel, ShipState};
@@ -31,6 +33,18 @@ pub struct MpcReport {
     pub r_dual: [f64; 2],
 }
 
+/// What an optimizer carries from one control sample to the next: its warm start
+/// (plans, multipliers, trust radii). The QPs and their factorisations, the cached
+/// linearisations and every buffer are rebuilt from the configuration; the next sample
+/// refills them with the same bits.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum OptimizerState {
+    /// The distributed MPC's.
+    Admm(Box<AdmmState>),
+    /// The centralized MPC's.
+    Centralized(CentralizedState),
+}
+
 /// An MPC architecture (module docs).
 pub trait Optimizer: std::fmt::Debug + Send {
     /// Solves one control sample within `budget`.
@@ -49,6 +63,22 @@ pub trait Optimizer: std::fmt::Debug + Send {
     fn reset(&mut self);
     /// Warm start of the next sample: everything one sample ahead.
     fn shift(&mut self);
+    /// The state to carry over ([`OptimizerState`]).
+    fn snapshot(&self) -> OptimizerState;
+    /// Goes on from `state`, a snapshot of an optimizer of the same architecture and
+    /// problem.
+    ///
+    /// # Errors
+    /// Another architecture's state, or one that does not fit (nothing changes then).
+    fn restore(&mut self, state: &OptimizerState) -> Result<(), String>;
+}
+
+fn wrong_architecture(state: &OptimizerState, expected: &str) -> String {
+    let found = match state {
+        OptimizerState::Admm(_) => "distributed (ADMM)",
+        OptimizerState::Centralized(_) => "centralized",
+    };
+    format!("the state is of the {found} MPC, this controller's is {expected}")
 }
 
 impl Optimizer for Admm {
@@ -95,6 +125,17 @@ impl Optimizer for Admm {
     fn shift(&mut self) {
         Admm::shift(self);
     }
+
+    fn snapshot(&self) -> OptimizerState {
+        OptimizerState::Admm(Box::new(Admm::snapshot(self)))
+    }
+
+    fn restore(&mut self, state: &OptimizerState) -> Result<(), String> {
+        match state {
+            OptimizerState::Admm(s) => Admm::restore(self, s),
+            other => Err(wrong_architecture(other, "distributed (ADMM)")),
+        }
+    }
 }
 
 impl Optimizer for Centralized {
@@ -137,5 +178,16 @@ impl Optimizer for Centralized {
 
     fn shift(&mut self) {
         Centralized::shift(self);
+    }
+
+    fn snapshot(&self) -> OptimizerState {
+        OptimizerState::Centralized(Centralized::snapshot(self))
+    }
+
+    fn restore(&mut self, state: &OptimizerState) -> Result<(), String> {
+        match state {
+            OptimizerState::Centralized(s) => Centralized::restore(self, s),
+            other => Err(wrong_architecture(other, "centralized")),
+        }
     }
 }

@@ -340,7 +340,7 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
         Ok(())
     }
 
-    fn serialize_state(&self, out: &mut Vec<u8>) {
+    fn serialize_state(&self, out: &mut Vec<u8>) -> Result<(), String> {
         out.push(1); // model state version
         for x in [self.u, self.y, self.t_const, self.y0] {
             out.extend_from_slice(&x.to_le_bytes());
@@ -351,6 +351,7 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
         out.push(u8::from(self.enabled));
         out.extend_from_slice(&(self.label.len() as u32).to_le_bytes());
         out.extend_from_slice(self.label.as_bytes());
+        Ok(())
     }
 
     fn deserialize_state(&mut self, _log: &Logger, b: &[u8]) -> Result<(), String> {

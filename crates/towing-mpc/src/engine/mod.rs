@@ -37,6 +37,8 @@ mod space;
 mod trust;
 
 use std::fmt::Debug;
+
+use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 
 pub use quad::QuadModel;
@@ -213,6 +215,19 @@ impl Merit for f64 {
     }
 }
 
+/// What an [`Scp`] keeps from one control sample to the next that decides its later
+/// steps: the plan (the warm start; `None` when the next sample starts cold and sets its
+/// own) and the trust region's radius. Everything else (the QPs, the cached
+/// linearisation, the buffers) is rebuilt or refilled by the next step from the same
+/// data, with the same bits: a controller's FMU state holds this.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ScpState {
+    /// The plan, flat ([`Scp::plan`]).
+    pub plan: Option<Vec<f64>>,
+    /// The trust region's radius.
+    pub radius: f64,
+}
+
 /// The SCP's working memory over a subproblem, and its step (module docs).
 #[derive(Debug)]
 pub struct Scp<P: Subproblem> {
@@ -304,6 +319,55 @@ impl<P: Subproblem> Scp<P> {
     /// Forgets the cached linearisation (the next step linearises anew).
     pub fn forget_linearisation(&mut self) {
         self.lin_key = None;
+    }
+
+    /// The state to carry over ([`ScpState`]); the plan only when `warm` (the next
+    /// sample starts from it).
+    #[must_use]
+    pub fn snapshot(&self, warm: bool) -> ScpState {
+        ScpState {
+            plan: warm.then(|| self.plan.clone()),
+            radius: self.trust.radius(),
+        }
+    }
+
+    /// Whether [`restore`](Self::restore) takes `state`.
+    ///
+    /// # Errors
+    /// A plan of another length, a radius outside the trust region's bounds.
+    pub fn fits(&self, state: &ScpState) -> Result<(), String> {
+        let s = self.trust.settings();
+        if !(s.min_radius..=s.max_radius).contains(&state.radius) {
+            return Err(format!(
+                "trust radius {} is outside [{}, {}]",
+                state.radius, s.min_radius, s.max_radius
+            ));
+        }
+        if let Some(plan) = &state.plan {
+            if plan.len() != self.plan.len() {
+                return Err(format!(
+                    "a plan of {} values, the problem has {}",
+                    plan.len(),
+                    self.plan.len()
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Goes on from `state` (a [`snapshot`](Self::snapshot), possibly of another
+    /// instance of the same problem); the linearisation is made anew at the next step.
+    ///
+    /// # Errors
+    /// As [`fits`](Self::fits) (nothing changes then).
+    pub fn restore(&mut self, state: &ScpState) -> Result<(), String> {
+        self.fits(state)?;
+        if let Some(plan) = &state.plan {
+            self.plan.copy_from_slice(plan);
+        }
+        self.trust.set_radius(state.radius);
+        self.forget_linearisation();
+        Ok(())
     }
 
     /// Moves the plan one sample ahead, the last sample repeated (warm start of
