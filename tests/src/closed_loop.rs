@@ -10,7 +10,7 @@
 //! its initialization are set on the plant.
 
 use fmi_rs::fmi2::builder::FMU2Builder;
-use fmi_rs::fmi2::types::fmi2Status;
+use fmi_rs::fmi2::types::{fmi2FMUstate, fmi2Status};
 use fmi_rs::fmi2::{CS, FMU2};
 use fmi_rs::model_description::fmi2::{Causality, ModelDescription, VariableType};
 use std::path::Path;
@@ -117,6 +117,8 @@ struct Unit {
     /// Scratch values of the connected inputs (Real; Integer and Boolean), reused each step.
     in_reals: Vec<f64>,
     in_ints: Vec<i32>,
+    /// Value references by variable name (for parameters).
+    parameters: std::collections::HashMap<String, u32>,
 }
 
 /// `what` is formatted only for an error (the per-step calls pass `format_args!`).
@@ -160,7 +162,54 @@ impl Unit {
             inputs: Inputs::default(),
             in_reals: Vec::new(),
             in_ints: Vec::new(),
+            parameters: md
+                .modelVariables
+                .iter()
+                .map(|v| (v.name.clone(), v.valueReference))
+                .collect(),
         }
+    }
+
+    fn parameter(&self, name: &str) -> Result<u32, String> {
+        self.parameters
+            .get(name)
+            .copied()
+            .ok_or_else(|| format!("{}: no variable {name}", self.name))
+    }
+
+    /// The instance's state, serialized.
+    fn serialize(&self, w: &mut usize) -> Result<Vec<u8>, String> {
+        let name = self.name;
+        let mut state: fmi2FMUstate = std::ptr::null_mut();
+        check(
+            self.fmu.getFMUstate(&mut state),
+            format_args!("{name}: getFMUstate"),
+            w,
+        )?;
+        let mut size = 0;
+        let sized = self.fmu.serializedFMUstateSize(state, &mut size);
+        let mut bytes = vec![0; size];
+        let serialized = self.fmu.serializeFMUstate(state, &mut bytes);
+        let freed = self.fmu.freeFMUstate(&mut state);
+        check(sized, format_args!("{name}: serializedFMUstateSize"), w)?;
+        check(serialized, format_args!("{name}: serializeFMUstate"), w)?;
+        check(freed, format_args!("{name}: freeFMUstate"), w)?;
+        Ok(bytes)
+    }
+
+    /// Restores the instance from serialized bytes.
+    fn deserialize(&self, bytes: &[u8], w: &mut usize) -> Result<(), String> {
+        let name = self.name;
+        let mut state: fmi2FMUstate = std::ptr::null_mut();
+        check(
+            self.fmu.deSerializeFMUstate(bytes, &mut state),
+            format_args!("{name}: deSerializeFMUstate"),
+            w,
+        )?;
+        let set = self.fmu.setFMUstate(state);
+        let freed = self.fmu.freeFMUstate(&mut state);
+        check(set, format_args!("{name}: setFMUstate"), w)?;
+        check(freed, format_args!("{name}: freeFMUstate"), w)
     }
 
     /// Reads the outputs by type; stops at the first call that fails.
@@ -296,121 +345,253 @@ pub fn run_closed_loop(
     step: f64,
     steps: u32,
 ) -> Result<Trajectory, String> {
-    let load = |p: &Path| FMU2Builder::new(&p).map_err(|e| format!("{}: {e}", p.display()));
-    let plant_b = load(plant_fmu)?;
-    let ctrl_b = load(controller_fmu)?;
-    let (p_md, c_md) = (&plant_b.model_description, &ctrl_b.model_description);
-    let instantiate = |b: &FMU2Builder, name: &str| {
-        b.instantiate_cs(name)
-            .map_err(|e| format!("instantiating {name}: {e}"))
-    };
-    let mut plant = Unit::new("plant", instantiate(&plant_b, "plant")?, p_md);
-    let mut ctrl = Unit::new("controller", instantiate(&ctrl_b, "controller")?, c_md);
-    let (to_ctrl, to_controller) = connect(&plant, p_md, c_md, "controller")?;
-    let (to_plant_inputs, to_plant) = connect(&ctrl, c_md, p_md, "plant")?;
-    ctrl.inputs = to_ctrl;
-    plant.inputs = to_plant_inputs;
-
-    let mut warnings = 0;
-    let w = &mut warnings;
+    let mut lp = ClosedLoop::load(plant_fmu, controller_fmu)?;
     let stop = f64::from(steps) * step;
-    let exchanged = initial_inputs == InitialInputs::Exchanged;
-    check(
-        plant.fmu.setupExperiment(None, 0.0, Some(stop)),
-        "plant: setupExperiment",
-        w,
-    )?;
-    check(
-        plant.fmu.enterInitializationMode(),
-        "plant: enterInitializationMode",
-        w,
-    )?;
-    check(
-        plant.fmu.exitInitializationMode(),
-        "plant: exitInitializationMode",
-        w,
-    )?;
-    check(
-        ctrl.fmu.setupExperiment(None, 0.0, Some(stop)),
-        "controller: setupExperiment",
-        w,
-    )?;
-    check(
-        ctrl.fmu.enterInitializationMode(),
-        "controller: enterInitializationMode",
-        w,
-    )?;
-    plant.read_outputs(w)?;
-    if exchanged {
-        ctrl.take_inputs(Some(&plant), w)?;
+    lp.initialize(initial_inputs, stop, &[])?;
+    let mut rows = vec![lp.record(0.0)];
+    rows.extend(lp.run(coupling, initial_inputs, step, 0..steps)?);
+    lp.finish(rows)
+}
+
+/// Both FMUs loaded, instantiated and connected by name (module docs), stepped a range of
+/// steps at a time; their FMU states saved to and restored from files.
+pub struct ClosedLoop {
+    /// The unpacked FMUs (their folders live as long as these).
+    _builders: [FMU2Builder; 2],
+    plant: Unit,
+    ctrl: Unit,
+    to_controller: Vec<String>,
+    to_plant: Vec<String>,
+    warnings: usize,
+}
+
+impl std::fmt::Debug for ClosedLoop {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ClosedLoop")
+            .field("warnings", &self.warnings)
+            .finish_non_exhaustive()
     }
-    check(
-        ctrl.fmu.exitInitializationMode(),
-        "controller: exitInitializationMode",
-        w,
-    )?;
-    ctrl.read_outputs(w)?;
-    if exchanged {
-        plant.take_inputs(Some(&ctrl), w)?;
+}
+
+/// The files [`ClosedLoop::save`] writes into a folder.
+const STATE_FILES: [&str; 2] = ["plant.state", "controller.state"];
+
+impl ClosedLoop {
+    /// Loads and instantiates both FMUs and connects them.
+    ///
+    /// # Errors
+    /// An FMU that cannot be loaded or instantiated, inputs that cannot be connected.
+    pub fn load(plant_fmu: &Path, controller_fmu: &Path) -> Result<Self, String> {
+        let load = |p: &Path| FMU2Builder::new(&p).map_err(|e| format!("{}: {e}", p.display()));
+        let plant_b = load(plant_fmu)?;
+        let ctrl_b = load(controller_fmu)?;
+        let (p_md, c_md) = (&plant_b.model_description, &ctrl_b.model_description);
+        let instantiate = |b: &FMU2Builder, name: &str| {
+            b.instantiate_cs(name)
+                .map_err(|e| format!("instantiating {name}: {e}"))
+        };
+        let mut plant = Unit::new("plant", instantiate(&plant_b, "plant")?, p_md);
+        let mut ctrl = Unit::new("controller", instantiate(&ctrl_b, "controller")?, c_md);
+        let (to_ctrl, to_controller) = connect(&plant, p_md, c_md, "controller")?;
+        let (to_plant_inputs, to_plant) = connect(&ctrl, c_md, p_md, "plant")?;
+        ctrl.inputs = to_ctrl;
+        plant.inputs = to_plant_inputs;
+        Ok(Self {
+            _builders: [plant_b, ctrl_b],
+            plant,
+            ctrl,
+            to_controller,
+            to_plant,
+            warnings: 0,
+        })
     }
 
-    let columns: Vec<String> = std::iter::once("time".to_owned())
-        .chain(plant.column_names().cloned())
-        .chain(ctrl.column_names().cloned())
-        .collect();
-    let record = |t: f64, plant: &Unit, ctrl: &Unit| -> Vec<f64> {
-        std::iter::once(t)
-            .chain(plant.values())
-            .chain(ctrl.values())
-            .collect()
-    };
-    let mut rows = vec![record(0.0, &plant, &ctrl)];
-    for k in 0..steps {
-        let t = f64::from(k) * step;
-        let zero = k == 0 && !exchanged;
-        let plant_out = (!zero).then_some(&plant);
-        ctrl.take_inputs(plant_out, w)?;
-        match coupling {
-            Coupling::GaussSeidel => {
-                check(
-                    ctrl.fmu.doStep(t, step, 1),
-                    format_args!("controller: doStep at t = {t} s"),
-                    w,
-                )?;
-                ctrl.read_outputs(w)?;
-                plant.take_inputs(Some(&ctrl), w)?;
-                check(
-                    plant.fmu.doStep(t, step, 1),
-                    format_args!("plant: doStep at t = {t} s"),
-                    w,
-                )?;
-            }
-            Coupling::Jacobi => {
-                let ctrl_out = (!zero).then_some(&ctrl);
-                plant.take_inputs(ctrl_out, w)?;
-                check(
-                    ctrl.fmu.doStep(t, step, 1),
-                    format_args!("controller: doStep at t = {t} s"),
-                    w,
-                )?;
-                check(
-                    plant.fmu.doStep(t, step, 1),
-                    format_args!("plant: doStep at t = {t} s"),
-                    w,
-                )?;
-                ctrl.read_outputs(w)?;
-            }
+    /// Initializes both (module docs) with a stop time, the controller's Integer (or
+    /// Enumeration) parameters `controller_params` set first.
+    ///
+    /// # Errors
+    /// A call that fails, an unknown parameter.
+    pub fn initialize(
+        &mut self,
+        initial_inputs: InitialInputs,
+        stop: f64,
+        controller_params: &[(&str, i32)],
+    ) -> Result<(), String> {
+        let (plant, ctrl, w) = (&mut self.plant, &mut self.ctrl, &mut self.warnings);
+        for &(name, value) in controller_params {
+            let vr = ctrl.parameter(name)?;
+            check(
+                ctrl.fmu.setInteger(&[vr], &[value]),
+                format_args!("controller: {name}"),
+                w,
+            )?;
         }
+        let exchanged = initial_inputs == InitialInputs::Exchanged;
+        check(
+            plant.fmu.setupExperiment(None, 0.0, Some(stop)),
+            "plant: setupExperiment",
+            w,
+        )?;
+        check(
+            plant.fmu.enterInitializationMode(),
+            "plant: enterInitializationMode",
+            w,
+        )?;
+        check(
+            plant.fmu.exitInitializationMode(),
+            "plant: exitInitializationMode",
+            w,
+        )?;
+        check(
+            ctrl.fmu.setupExperiment(None, 0.0, Some(stop)),
+            "controller: setupExperiment",
+            w,
+        )?;
+        check(
+            ctrl.fmu.enterInitializationMode(),
+            "controller: enterInitializationMode",
+            w,
+        )?;
         plant.read_outputs(w)?;
-        rows.push(record(f64::from(k + 1) * step, &plant, &ctrl));
+        if exchanged {
+            ctrl.take_inputs(Some(plant), w)?;
+        }
+        check(
+            ctrl.fmu.exitInitializationMode(),
+            "controller: exitInitializationMode",
+            w,
+        )?;
+        ctrl.read_outputs(w)?;
+        if exchanged {
+            plant.take_inputs(Some(ctrl), w)?;
+        }
+        Ok(())
     }
-    check(ctrl.fmu.terminate(), "controller: terminate", w)?;
-    check(plant.fmu.terminate(), "plant: terminate", w)?;
-    Ok(Trajectory {
-        columns,
-        rows,
-        to_controller,
-        to_plant,
-        warnings,
-    })
+
+    /// `time`, every plant output, every controller output (as [`Trajectory`]).
+    #[must_use]
+    pub fn record(&self, t: f64) -> Vec<f64> {
+        std::iter::once(t)
+            .chain(self.plant.values())
+            .chain(self.ctrl.values())
+            .collect()
+    }
+
+    /// Communication steps `range` (step `k` from t = k h): the rows after each.
+    ///
+    /// # Errors
+    /// A step or an exchange that fails.
+    pub fn run(
+        &mut self,
+        coupling: Coupling,
+        initial_inputs: InitialInputs,
+        step: f64,
+        range: std::ops::Range<u32>,
+    ) -> Result<Vec<Vec<f64>>, String> {
+        let exchanged = initial_inputs == InitialInputs::Exchanged;
+        let mut rows = Vec::with_capacity(range.len());
+        for k in range {
+            let (plant, ctrl, w) = (&mut self.plant, &mut self.ctrl, &mut self.warnings);
+            let t = f64::from(k) * step;
+            let zero = k == 0 && !exchanged;
+            let plant_out = (!zero).then_some(&*plant);
+            ctrl.take_inputs(plant_out, w)?;
+            match coupling {
+                Coupling::GaussSeidel => {
+                    check(
+                        ctrl.fmu.doStep(t, step, 1),
+                        format_args!("controller: doStep at t = {t} s"),
+                        w,
+                    )?;
+                    ctrl.read_outputs(w)?;
+                    plant.take_inputs(Some(ctrl), w)?;
+                    check(
+                        plant.fmu.doStep(t, step, 1),
+                        format_args!("plant: doStep at t = {t} s"),
+                        w,
+                    )?;
+                }
+                Coupling::Jacobi => {
+                    let ctrl_out = (!zero).then_some(&*ctrl);
+                    plant.take_inputs(ctrl_out, w)?;
+                    check(
+                        ctrl.fmu.doStep(t, step, 1),
+                        format_args!("controller: doStep at t = {t} s"),
+                        w,
+                    )?;
+                    check(
+                        plant.fmu.doStep(t, step, 1),
+                        format_args!("plant: doStep at t = {t} s"),
+                        w,
+                    )?;
+                    ctrl.read_outputs(w)?;
+                }
+            }
+            plant.read_outputs(w)?;
+            rows.push(self.record(f64::from(k + 1) * step));
+        }
+        Ok(rows)
+    }
+
+    /// Serializes both FMUs' states (`fmi2SerializeFMUstate`) into `plant.state` and
+    /// `controller.state` in `dir`.
+    ///
+    /// # Errors
+    /// A call that fails, a file that cannot be written.
+    pub fn save(&mut self, dir: &Path) -> Result<(), String> {
+        for (unit, file) in [&self.plant, &self.ctrl].into_iter().zip(STATE_FILES) {
+            let bytes = unit.serialize(&mut self.warnings)?;
+            std::fs::write(dir.join(file), bytes)
+                .map_err(|e| format!("writing {}: {e}", dir.join(file).display()))?;
+        }
+        Ok(())
+    }
+
+    /// Restores both FMUs from the files [`save`](Self::save) wrote
+    /// (`fmi2DeSerializeFMUstate`, `fmi2SetFMUstate`), into instances that were only set
+    /// up (`fmi2SetupExperiment` with `stop`), and reads their outputs.
+    ///
+    /// # Errors
+    /// A call that fails, a file that cannot be read.
+    pub fn restore(&mut self, dir: &Path, stop: f64) -> Result<(), String> {
+        for (unit, file) in [&mut self.plant, &mut self.ctrl]
+            .into_iter()
+            .zip(STATE_FILES)
+        {
+            let w = &mut self.warnings;
+            let path = dir.join(file);
+            let bytes =
+                std::fs::read(&path).map_err(|e| format!("reading {}: {e}", path.display()))?;
+            let name = unit.name;
+            check(
+                unit.fmu.setupExperiment(None, 0.0, Some(stop)),
+                format_args!("{name}: setupExperiment"),
+                w,
+            )?;
+            unit.deserialize(&bytes, w)?;
+            unit.read_outputs(w)?;
+        }
+        Ok(())
+    }
+
+    /// Terminates both and returns the trajectory of `rows`.
+    ///
+    /// # Errors
+    /// A terminate that fails.
+    pub fn finish(mut self, rows: Vec<Vec<f64>>) -> Result<Trajectory, String> {
+        let w = &mut self.warnings;
+        check(self.ctrl.fmu.terminate(), "controller: terminate", w)?;
+        check(self.plant.fmu.terminate(), "plant: terminate", w)?;
+        let columns: Vec<String> = std::iter::once("time".to_owned())
+            .chain(self.plant.column_names().cloned())
+            .chain(self.ctrl.column_names().cloned())
+            .collect();
+        Ok(Trajectory {
+            columns,
+            rows,
+            to_controller: self.to_controller,
+            to_plant: self.to_plant,
+            warnings: self.warnings,
+        })
+    }
 }
