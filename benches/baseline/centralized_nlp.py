@@ -15,7 +15,9 @@ The same problem, term by term (the Rust source each line follows in brackets):
   ship's (centralized.rs `Start::of`);
 - the ship's stage terms (ship_mpc.rs `ship_stage_terms`): w_S1 |eta - eta_d|^2 (heading
   wrapped), w_S2 |nu|^2, w_F F^2 (and w_alpha alpha^2), the one-sided heading floor
-  w_P min(0, psi - psi_floor)^2, the terminal term w |e_H + tau eta_dot_H|^2;
+  w_P min(0, psi - psi_floor)^2, the terminal term w |e_H + tau eta_dot_H|^2, and the
+  motion limits (costs.rs `MotionLimits`: drift, sternway and speed rows, each a gap with
+  the exact penalty W max(0, b - g(x)) like the clearance rows);
 - the tugs' terms (centralized.rs `Problem::accumulate`): w_i1 |g_i - f_i|^2 with f_i the
   formation pose (formation.rs, towline::formation_pose), w_i2 |nu_i|^2, and the thrust
   rate term w_dtau sum |tau_h - tau_h-1|^2 (centralized.rs `thrust_rate_terms`);
@@ -259,6 +261,17 @@ def obstacle_terms(terms: Terms, params: dict, weight: float, obstacles, h: int,
         terms.gaps.append((cl["min_distance"] - d, cl["penalty"]))
 
 
+def motion_terms(terms: Terms, sp: dict, x):
+    """costs.rs `MotionLimits::terms`: the drift, sternway and speed rows as gaps b - g(x)."""
+    m = sp["motion"]
+    if m["penalty"] <= 0.0:
+        return
+    t = math.tan(m["max_drift"])
+    for bound, g in [(-m["sway_allowance"], t * x[3] - x[4]), (-m["sway_allowance"], t * x[3] + x[4]),
+                     (-m["max_sternway"], x[3]), (-m["max_speed"], -x[3])]:
+        terms.gaps.append((bound - g, m["penalty"]))
+
+
 def ship_stage(terms: Terms, sp: dict, x, ref, u, last: bool, floor):
     """ship_mpc.rs `ship_stage_terms`."""
     value, on = floor
@@ -303,6 +316,7 @@ def cost_terms(problem: dict, u, p, n_obs: int) -> Terms:
     for h in range(H):
         x = ship_x[h]
         ship_stage(terms, sp, x, reference[h], ship_u[h], h + 1 == H, floor)
+        motion_terms(terms, sp, x)
         obstacle_terms(terms, sp, sp["weight_distance"], obstacles, h, x[:2])
         for i in range(2):
             g = tug_x[i][h]

@@ -385,6 +385,9 @@ fn problem_json(config: &ControllerConfig) -> Res<Value> {
             "distance": distance(&ship.distance),
             "clearance": clearance(&ship.clearance),
             "weight_port_turn": ship.weight_port_turn,
+            "motion": {"max_drift": ship.motion.max_drift, "sway_allowance": ship.motion.sway_allowance,
+                       "max_sternway": ship.motion.max_sternway, "max_speed": ship.motion.max_speed,
+                       "penalty": ship.motion.penalty},
         },
         "tug": {
             "pose_weights": tug.state_weights().0,

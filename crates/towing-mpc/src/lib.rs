@@ -111,7 +111,7 @@ pub use admm::{
     Admm, AdmmBuildError, AdmmReport, AdmmSettings, AppliedCommand, IterationRecord, SampleInput,
 };
 pub use centralized::{Centralized, CentralizedReport, CentralizedSettings, CostBreakdown};
-pub use costs::{angle_difference, ClearanceParams};
+pub use costs::{angle_difference, ClearanceParams, MotionLimits};
 pub use engine::{Budget, Merit, Scp, ScpReport, ScpSettings, Subproblem, TrustRegion};
 pub use formation::FormationMap;
 pub use hull::{JacobianMethod, PredictionHull};
