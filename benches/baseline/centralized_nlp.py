@@ -65,24 +65,28 @@ def angle_difference_float(a: float, b: float) -> float:
     return d - TAU if d > math.pi else d
 
 
-def obstacle_parameters(o: dict) -> list[float]:
-    """[cx, cy, a, focal, cos, sin, drift_x, drift_y] of a recorded obstacle; a circle is the
-    focal form with a = radius and focal distance 0, which gives exactly |p - c| - R."""
+def obstacle_parameters(o: dict, cost_on: bool) -> list[float]:
+    """[cx, cy, a, focal, cos, sin, drift_x, drift_y, cost_on] of a recorded obstacle; a circle
+    is the focal form with a = radius and focal distance 0, which gives exactly |p - c| - R;
+    cost_on is 0 for an obstacle the sample leaves out of the distance cost (costs.rs
+    `obstacle_terms`, `distance_cost_off`)."""
+    flag = 1.0 if cost_on else 0.0
     if o["kind"] == "circle":
         r = o["radius"]
-        return [o["centre"][0], o["centre"][1], r, 0.0, 1.0, 0.0, 0.0, 0.0]
+        return [o["centre"][0], o["centre"][1], r, 0.0, 1.0, 0.0, 0.0, 0.0, flag]
     a, b, th = o["semi_major"], o["semi_minor"], o["orientation"]
     f = math.sqrt(max(a * a - b * b, 0.0))
-    return [o["centre"][0], o["centre"][1], a, f, math.cos(th), math.sin(th), o["drift"][0], o["drift"][1]]
+    return [o["centre"][0], o["centre"][1], a, f, math.cos(th), math.sin(th), o["drift"][0], o["drift"][1],
+            flag]
 
 
-OBSTACLE_PARAMS = 8
+OBSTACLE_PARAMS = 9
 
 
 def parameters(sample: dict) -> list[float]:
     """The NLP's parameter vector of a recorded sample: ship state (6), tug states with
     headings unwrapped next to the ship's (12), previous tug thrusts (6), reference (9),
-    heading floor and whether it is on (2), obstacles (8 each)."""
+    heading floor and whether it is on (2), obstacles (9 each)."""
     ship = list(sample["ship"])
     p = list(ship)
     for tug in sample["tugs"]:
@@ -95,8 +99,9 @@ def parameters(sample: dict) -> list[float]:
         p += list(ref)
     floor = sample["heading_floor"]
     p += [0.0, 0.0] if floor is None else [floor, 1.0]
-    for o in sample["obstacles"]:
-        p += obstacle_parameters(o)
+    off = sample.get("distance_cost_off", 0)
+    for j, o in enumerate(sample["obstacles"]):
+        p += obstacle_parameters(o, (off >> j) & 1 == 0)
     return p
 
 
@@ -257,7 +262,7 @@ def obstacle_terms(terms: Terms, params: dict, weight: float, obstacles, h: int,
     for o in obstacles:
         d = obstacle_distance(o, h + 1, pos)
         if weight > 0.0:
-            terms.smooth = terms.smooth + weight * phi(params["distance"], d)
+            terms.smooth = terms.smooth + o[8] * weight * phi(params["distance"], d)
         terms.gaps.append((cl["min_distance"] - d, cl["penalty"]))
 
 

@@ -416,6 +416,7 @@ fn sample_json(s: &Recorded) -> Value {
         "reference": i.reference,
         "heading_floor": i.heading_floor,
         "obstacles": i.obstacles(),
+        "distance_cost_off": i.distance_cost_off,
         "loop": {"ship": s.ship, "tugs": s.tugs, "fallback": s.fallback},
     })
 }
@@ -500,6 +501,9 @@ fn input_from(v: &Value, k: usize) -> Res<MpcInput> {
         },
         reference: nested(&v["reference"], &format!("{what}.reference"))?,
         obstacles: &obstacles,
+        distance_cost_off: v["distance_cost_off"]
+            .as_u64()
+            .ok_or_else(|| format!("{what}.distance_cost_off: not an unsigned integer"))?,
         heading_floor,
     };
     Ok(MpcInput::of(&input))

@@ -388,13 +388,14 @@ impl Controller {
         let start = Instant::now();
         m.validate()?;
         let guided = self.guide(m)?;
-        let n_obstacles = self.select_obstacles(m);
+        let (n_obstacles, distance_cost_off) = self.select_obstacles(m);
         let input = SampleInput {
             ship: m.ship,
             tugs: m.tugs,
             previous: self.applied,
             reference: [guided.reference; HORIZON],
             obstacles: &self.mpc_obstacles[..n_obstacles],
+            distance_cost_off,
             heading_floor: guided.heading_floor,
         };
         self.last_input = Some(MpcInput::of(&input));
@@ -811,8 +812,10 @@ impl Controller {
     }
 
     /// Copies the nearest obstacles (by range from the tow) into the MPC's list;
-    /// returns how many.
-    fn select_obstacles(&mut self, m: &Measurement) -> usize {
+    /// returns how many, and which of them the distance cost leaves out: in schemes
+    /// I and II, the targets the tow stands on until Rule 17 allows action
+    /// ([`towing_guidance::ReferenceSystem::stands_on`]; their clearance rows stay).
+    fn select_obstacles(&mut self, m: &Measurement) -> (usize, u64) {
         let t = &self.config.tuning;
         let slots = t
             .ship
@@ -842,10 +845,15 @@ impl Controller {
         }
         candidates[..n].sort_by(|a, b| a.0.total_cmp(&b.0));
         let used = n.min(slots);
+        let mut off = 0u64;
+        let alters = self.config.tuning.scheme.alters();
         for (j, &(_, k)) in candidates[..used].iter().enumerate() {
             self.mpc_obstacles[j] = mpc_obstacle(&m.obstacles[k], ts);
+            if alters && self.guidance.stands_on(k) {
+                off |= 1 << j;
+            }
         }
-        used
+        (used, off)
     }
 
     fn prediction(&self, m: &Measurement, from_plan: bool) -> Prediction {

@@ -330,6 +330,15 @@ fn past_and_clear(
     })
 }
 
+/// The tow stands on for this assessment's target (see [`ReferenceSystem::stands_on`]).
+fn stands_on(params: &GuidanceParams, a: &ObstacleAssessment) -> bool {
+    let rule17 = &params.settings().colregs.rule17;
+    matches!(a.action, Action::StandOn | Action::StandOnThenAct)
+        && a.manoeuvre == Manoeuvre::FollowRoute
+        && !a.past_and_clear
+        && a.encounter.is_some_and(|e| !rule17.give_way_failed(&e.cpa))
+}
+
 /// Output of one sample.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct GuidanceOutput {
@@ -384,6 +393,9 @@ pub struct ReferenceSystem {
     crossed: u64,
     /// Per slot: past and clear at the last sample.
     past: u64,
+    /// Per slot: a target the tow stands on at the last sample, Rule 17 not yet
+    /// allowing action.
+    standing_on: u64,
     held: [Option<Situation>; MAX_OBSTACLES],
     situations: [Option<Situation>; MAX_OBSTACLES],
     sightings: [Option<Sighting>; MAX_OBSTACLES],
@@ -401,6 +413,7 @@ impl ReferenceSystem {
             cleared: 0,
             crossed: 0,
             past: 0,
+            standing_on: 0,
             held: [None; MAX_OBSTACLES],
             situations: [None; MAX_OBSTACLES],
             sightings: [None; MAX_OBSTACLES],
@@ -414,6 +427,7 @@ impl ReferenceSystem {
         self.cleared = 0;
         self.crossed = 0;
         self.past = 0;
+        self.standing_on = 0;
         self.held = [None; MAX_OBSTACLES];
         self.situations = [None; MAX_OBSTACLES];
         self.sightings = [None; MAX_OBSTACLES];
@@ -451,6 +465,16 @@ impl ReferenceSystem {
     #[must_use]
     pub fn past_and_clear(&self, slot: usize) -> bool {
         slot < MAX_OBSTACLES && self.past & (1 << slot) != 0
+    }
+
+    /// True when the tow stands on for the target ship in slot `slot` at the last
+    /// [`update`](Self::update): its policy is to keep course and speed
+    /// ([`Action::StandOn`], [`Action::StandOnThenAct`]), it is neither past and
+    /// clear nor at close quarters (Rule 17(a)(ii), (b): the TCPA and DCPA limits of
+    /// [`crate::Rule17Settings`]), and the route is kept for it.
+    #[must_use]
+    pub fn stands_on(&self, slot: usize) -> bool {
+        slot < MAX_OBSTACLES && self.standing_on & (1 << slot) != 0
     }
 
     /// True while an encounter keeps the route altered.
@@ -524,6 +548,7 @@ impl ReferenceSystem {
         let mut cleared = 0u64;
         let mut crossed = 0u64;
         let mut past = 0u64;
+        let mut standing_on = 0u64;
         let mut held = [None; MAX_OBSTACLES];
         let mut situations = [None; MAX_OBSTACLES];
         let mut sightings = [None; MAX_OBSTACLES];
@@ -551,9 +576,6 @@ impl ReferenceSystem {
             };
             let a = assess_obstacle(&self.params, tow, index, &obstacle, &context);
             situations[index] = a.situation;
-            if a.past_and_clear {
-                past |= 1 << index;
-            }
             if a.range < d_ob {
                 d_ob = a.range;
                 nearest = Some(a);
@@ -563,6 +585,12 @@ impl ReferenceSystem {
                 _ => s.detection_distance,
             };
             let in_encounter = a.range <= detection + s.release_margin;
+            if a.past_and_clear {
+                past |= bit;
+            }
+            if in_encounter && stands_on(&self.params, &a) {
+                standing_on |= bit;
+            }
             if let (true, Some(situation)) = (in_encounter, a.situation) {
                 let definite = situation != Situation::Safe;
                 held[index] = held_before.or((a.detected && definite).then_some(situation));
@@ -596,6 +624,7 @@ impl ReferenceSystem {
         self.cleared = cleared;
         self.crossed = crossed;
         self.past = past;
+        self.standing_on = standing_on;
         self.held = held;
         self.situations = situations;
         self.sightings = sightings;
@@ -870,6 +899,29 @@ mod tests {
         assert_eq!(g.encounter.unwrap().situation, Situation::Unclassified);
         assert_eq!(g.situation, Some(Situation::CrossingGiveWay));
         assert!(out.altered);
+    }
+
+    /// A target overtaking the tow from astern: the tow stands on (Rule 17(a)(i)), so
+    /// the controller leaves it out of the distance cost, until close quarters
+    /// (TCPA <= 30 s and DCPA < 2.5 m), when Rule 17(b) lets the tow act.
+    #[test]
+    fn the_tow_stands_on_for_an_overtaking_target_until_close_quarters() {
+        let tow = tow_at(Pose::new(0.0, 0.0, 0.0), 0.05);
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        // 6 m astern, 2 m to starboard, northbound at 0.12 m/s: DCPA 2 m, TCPA 86 s.
+        let far = vessel(-6.0, 2.0, 0.0, 0.12);
+        let out = rs.update(&tow, &[far]).unwrap();
+        assert_eq!(
+            out.governing.unwrap().situation,
+            Some(Situation::BeingOvertaken)
+        );
+        assert!(!out.altered && rs.stands_on(0));
+        // 2.5 m astern: TCPA 36 s, still standing on; 1.5 m astern: TCPA 21 s.
+        assert!(!rs.update(&tow, &[vessel(-2.5, 2.0, 0.0, 0.12)]).unwrap().altered);
+        assert!(rs.stands_on(0));
+        rs.update(&tow, &[vessel(-1.5, 2.0, 0.0, 0.12)]).unwrap();
+        assert!(!rs.stands_on(0));
+        assert!(!rs.stands_on(1) && !rs.stands_on(MAX_OBSTACLES));
     }
 
     #[test]

@@ -439,6 +439,7 @@ impl CentralProblem {
         obstacle_terms(
             quad,
             input.obstacles,
+            input.distance_cost_off,
             &sp.distance,
             sp.weight_distance,
             &sp.clearance,
@@ -524,6 +525,7 @@ impl CentralProblem {
                 obstacle_terms(
                     quad,
                     input.obstacles,
+                    input.distance_cost_off,
                     &tp.distance,
                     tp.weight_distance,
                     &tp.clearance,

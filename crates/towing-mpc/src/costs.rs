@@ -196,12 +196,14 @@ impl MotionLimits {
 /// The obstacle terms of one predicted position `pos` (the state after sample
 /// `h`; moving obstacles as predicted then, [`Obstacle::after`]) with
 /// `d(x, y)/du = (row_x, row_y)`: the distance cost `w phi(d)` of every obstacle
-/// and, for the first `params.max_obstacles`, the clearance penalty and (with
-/// `clearance`) the linearised row.
+/// but those of `distance_cost_off` (bit `j` for `obstacles[j]`) and, for the first
+/// `params.max_obstacles`, the clearance penalty and (with `clearance`) the
+/// linearised row.
 #[allow(clippy::too_many_arguments)] // the pieces of one term; three call sites
 pub(crate) fn obstacle_terms<const N: usize>(
     quad: &mut QuadModel,
     obstacles: &[Obstacle],
+    distance_cost_off: u64,
     distance: &DistanceCost,
     w: f64,
     params: &ClearanceParams,
@@ -213,12 +215,14 @@ pub(crate) fn obstacle_terms<const N: usize>(
 ) {
     for (j, obstacle) in obstacles.iter().enumerate() {
         let (d, grad) = obstacle.after(h + 1).distance(pos);
-        let (phi, slope, curvature) = distance.eval(d);
         let mut row = [0.0; N];
         for (r, (a, b)) in row.iter_mut().zip(row_x.iter().zip(row_y)) {
             *r = grad[0] * a + grad[1] * b;
         }
-        quad.curved(phi, slope, curvature, w, &row);
+        if j >= 64 || (distance_cost_off >> j) & 1 == 0 {
+            let (phi, slope, curvature) = distance.eval(d);
+            quad.curved(phi, slope, curvature, w, &row);
+        }
         if j < params.max_obstacles {
             quad.value += params.penalty_at(d);
             if let Some(c) = clearance.as_deref_mut() {

@@ -231,6 +231,8 @@ pub struct ShipStepData<'a> {
     pub rho: f64,
     /// Static obstacles.
     pub obstacles: &'a [Obstacle],
+    /// Obstacles left out of the distance cost ([`crate::SampleInput::distance_cost_off`]).
+    pub distance_cost_off: u64,
     /// The lowest heading the ship may take over the horizon (rad), from
     /// COLREGS: no turn to port while the tow gives way or stands on.
     pub heading_floor: Option<f64>,
@@ -491,6 +493,7 @@ fn accumulate(
         obstacle_terms(
             quad,
             data.obstacles,
+            data.distance_cost_off,
             &params.distance,
             w3,
             &params.clearance,
@@ -542,6 +545,7 @@ mod tests {
             lambda: [[[0.0; 3]; HORIZON]; 2],
             rho,
             obstacles: &[],
+            distance_cost_off: 0,
             heading_floor: None,
         }
     }
@@ -615,6 +619,40 @@ mod tests {
         assert!(total(1) > total(0), "{plan:?}");
         let states = mpc.predicted();
         assert!(states[HORIZON - 1][0] > 0.0 && states[HORIZON - 1][3] > 0.0);
+    }
+
+    /// A reference astern, and one abeam: without the motion limits the plan backs
+    /// the ship and drags her sideways beyond them; with them the predicted sternway
+    /// and drift stay inside (to the slack the exact penalty leaves, below 1 mm/s).
+    #[test]
+    fn motion_limits_keep_the_plan_from_sternway_and_sideways_motion() {
+        let worst = |params: ShipMpcParams, reference: [f64; 3]| {
+            let mut mpc = ship_mpc_with(params);
+            let data = data_at_rest(&mpc, reference, 0.0);
+            for _ in 0..40 {
+                assert!(mpc.step(&data).qp.is_usable());
+            }
+            let m = params.motion;
+            let t = m.max_drift.tan();
+            mpc.predicted().iter().fold(0.0f64, |w, x| {
+                let drift = x[4].abs() - (t * x[3] + m.sway_allowance);
+                let astern = -x[3] - m.max_sternway;
+                w.max(drift).max(astern)
+            })
+        };
+        let on = ShipMpcParams::default();
+        let off = ShipMpcParams {
+            motion: MotionLimits {
+                penalty: 0.0,
+                ..on.motion
+            },
+            ..on
+        };
+        for reference in [[-2.0, 0.0, 0.0], [0.0, 2.0, 0.0]] {
+            let (with, without) = (worst(on, reference), worst(off, reference));
+            assert!(with < 1e-3, "{reference:?}: {with} m/s beyond the limits");
+            assert!(without > 5e-3, "{reference:?}: {without} m/s without them");
+        }
     }
 
     /// A reference to port turns the ship to port; a heading floor at the

@@ -47,6 +47,7 @@ fn paper_input(obstacles: &[Obstacle]) -> SampleInput<'_> {
         previous: AppliedCommand::default(),
         reference: reference_ahead(&ship, 2.0),
         obstacles,
+        distance_cost_off: 0,
         heading_floor: None,
     }
 }
@@ -134,6 +135,7 @@ fn plant_like_next<'a>(a: &Admm, input: &SampleInput<'a>, r: &AdmmReport) -> Sam
         },
         reference: reference_ahead(&ship, 2.0),
         obstacles: input.obstacles,
+        distance_cost_off: input.distance_cost_off,
         heading_floor: None,
     }
 }
