@@ -661,8 +661,10 @@ mod tests {
     #[test]
     fn a_heading_floor_stops_a_turn_to_port() {
         let run = |floor: Option<f64>| {
+            // Table 3's heading weight: the floor's weight 1e4 against a pull of 1.
             let mut mpc = ship_mpc_with(ShipMpcParams {
                 weight_port_turn: 1e4,
+                weight_heading: 1.0,
                 ..ShipMpcParams::default()
             });
             let mut data = data_at_rest(&mpc, [1.0, -1.0, -0.5], 0.0);

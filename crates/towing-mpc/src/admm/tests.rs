@@ -6,10 +6,18 @@ use super::*;
 
 /// The coordination problem with the cost of eq. (13) as printed (no terminal
 /// term; the closed loop's default adds one, `docs/assumptions.md`).
+/// The cost as the paper prints it (eq. (13), Table 3): no terminal term, the heading
+/// weight of Table 3, no motion limits.
 pub(crate) fn printed_cost() -> ShipMpcParams {
+    let defaults = ShipMpcParams::default();
     ShipMpcParams {
         terminal: None,
-        ..ShipMpcParams::default()
+        weight_heading: 1.0,
+        motion: crate::MotionLimits {
+            penalty: 0.0,
+            ..defaults.motion
+        },
+        ..defaults
     }
 }
 
