@@ -15,7 +15,9 @@ The same problem, term by term (the Rust source each line follows in brackets):
   ship's (centralized.rs `Start::of`);
 - the ship's stage terms (ship_mpc.rs `ship_stage_terms`): w_S1 |eta - eta_d|^2 (heading
   wrapped), w_S2 |nu|^2, w_F F^2 (and w_alpha alpha^2), the one-sided heading floor
-  w_P min(0, psi - psi_floor)^2, the terminal term w |e_H + tau eta_dot_H|^2;
+  w_P min(0, psi - psi_floor)^2, the terminal term w |e_H + tau eta_dot_H|^2, and the
+  motion limits (costs.rs `MotionLimits`: drift, sternway and speed rows, each a gap with
+  the exact penalty W max(0, b - g(x)) like the clearance rows);
 - the tugs' terms (centralized.rs `Problem::accumulate`): w_i1 |g_i - f_i|^2 with f_i the
   formation pose (formation.rs, towline::formation_pose), w_i2 |nu_i|^2, and the thrust
   rate term w_dtau sum |tau_h - tau_h-1|^2 (centralized.rs `thrust_rate_terms`);
@@ -63,24 +65,28 @@ def angle_difference_float(a: float, b: float) -> float:
     return d - TAU if d > math.pi else d
 
 
-def obstacle_parameters(o: dict) -> list[float]:
-    """[cx, cy, a, focal, cos, sin, drift_x, drift_y] of a recorded obstacle; a circle is the
-    focal form with a = radius and focal distance 0, which gives exactly |p - c| - R."""
+def obstacle_parameters(o: dict, cost_on: bool) -> list[float]:
+    """[cx, cy, a, focal, cos, sin, drift_x, drift_y, cost_on] of a recorded obstacle; a circle
+    is the focal form with a = radius and focal distance 0, which gives exactly |p - c| - R;
+    cost_on is 0 for an obstacle the sample leaves out of the distance cost (costs.rs
+    `obstacle_terms`, `distance_cost_off`)."""
+    flag = 1.0 if cost_on else 0.0
     if o["kind"] == "circle":
         r = o["radius"]
-        return [o["centre"][0], o["centre"][1], r, 0.0, 1.0, 0.0, 0.0, 0.0]
+        return [o["centre"][0], o["centre"][1], r, 0.0, 1.0, 0.0, 0.0, 0.0, flag]
     a, b, th = o["semi_major"], o["semi_minor"], o["orientation"]
     f = math.sqrt(max(a * a - b * b, 0.0))
-    return [o["centre"][0], o["centre"][1], a, f, math.cos(th), math.sin(th), o["drift"][0], o["drift"][1]]
+    return [o["centre"][0], o["centre"][1], a, f, math.cos(th), math.sin(th), o["drift"][0], o["drift"][1],
+            flag]
 
 
-OBSTACLE_PARAMS = 8
+OBSTACLE_PARAMS = 9
 
 
 def parameters(sample: dict) -> list[float]:
     """The NLP's parameter vector of a recorded sample: ship state (6), tug states with
     headings unwrapped next to the ship's (12), previous tug thrusts (6), reference (9),
-    heading floor and whether it is on (2), obstacles (8 each)."""
+    heading floor and whether it is on (2), obstacles (9 each)."""
     ship = list(sample["ship"])
     p = list(ship)
     for tug in sample["tugs"]:
@@ -93,8 +99,9 @@ def parameters(sample: dict) -> list[float]:
         p += list(ref)
     floor = sample["heading_floor"]
     p += [0.0, 0.0] if floor is None else [floor, 1.0]
-    for o in sample["obstacles"]:
-        p += obstacle_parameters(o)
+    off = sample.get("distance_cost_off", 0)
+    for j, o in enumerate(sample["obstacles"]):
+        p += obstacle_parameters(o, (off >> j) & 1 == 0)
     return p
 
 
@@ -255,8 +262,19 @@ def obstacle_terms(terms: Terms, params: dict, weight: float, obstacles, h: int,
     for o in obstacles:
         d = obstacle_distance(o, h + 1, pos)
         if weight > 0.0:
-            terms.smooth = terms.smooth + weight * phi(params["distance"], d)
+            terms.smooth = terms.smooth + o[8] * weight * phi(params["distance"], d)
         terms.gaps.append((cl["min_distance"] - d, cl["penalty"]))
+
+
+def motion_terms(terms: Terms, sp: dict, x):
+    """costs.rs `MotionLimits::terms`: the drift, sternway and speed rows as gaps b - g(x)."""
+    m = sp["motion"]
+    if m["penalty"] <= 0.0:
+        return
+    t = math.tan(m["max_drift"])
+    for bound, g in [(-m["sway_allowance"], t * x[3] - x[4]), (-m["sway_allowance"], t * x[3] + x[4]),
+                     (-m["max_sternway"], x[3]), (-m["max_speed"], -x[3])]:
+        terms.gaps.append((bound - g, m["penalty"]))
 
 
 def ship_stage(terms: Terms, sp: dict, x, ref, u, last: bool, floor):
@@ -303,6 +321,7 @@ def cost_terms(problem: dict, u, p, n_obs: int) -> Terms:
     for h in range(H):
         x = ship_x[h]
         ship_stage(terms, sp, x, reference[h], ship_u[h], h + 1 == H, floor)
+        motion_terms(terms, sp, x)
         obstacle_terms(terms, sp, sp["weight_distance"], obstacles, h, x[:2])
         for i in range(2):
             g = tug_x[i][h]

@@ -162,6 +162,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         config.tuning.tug.weight_sway = v;
         config.tuning.tug.weight_yaw_rate = v;
     }
+    if let Some(v) = env("W_PSI") {
+        config.tuning.ship.weight_heading = v;
+    }
+    if let Some(v) = env("COURSE_RATE") {
+        config.tuning.tracking.course_rate = v.to_radians();
+    }
+    if let Some(v) = env("COURSE_LEAD") {
+        config.tuning.tracking.course_lead = v.to_radians();
+    }
     if let Some(v) = env("W_R") {
         config.tuning.ship.weight_yaw_rate = v;
     }

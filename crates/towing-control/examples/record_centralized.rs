@@ -385,6 +385,9 @@ fn problem_json(config: &ControllerConfig) -> Res<Value> {
             "distance": distance(&ship.distance),
             "clearance": clearance(&ship.clearance),
             "weight_port_turn": ship.weight_port_turn,
+            "motion": {"max_drift": ship.motion.max_drift, "sway_allowance": ship.motion.sway_allowance,
+                       "max_sternway": ship.motion.max_sternway, "max_speed": ship.motion.max_speed,
+                       "penalty": ship.motion.penalty},
         },
         "tug": {
             "pose_weights": tug.state_weights().0,
@@ -413,6 +416,7 @@ fn sample_json(s: &Recorded) -> Value {
         "reference": i.reference,
         "heading_floor": i.heading_floor,
         "obstacles": i.obstacles(),
+        "distance_cost_off": i.distance_cost_off,
         "loop": {"ship": s.ship, "tugs": s.tugs, "fallback": s.fallback},
     })
 }
@@ -497,6 +501,9 @@ fn input_from(v: &Value, k: usize) -> Res<MpcInput> {
         },
         reference: nested(&v["reference"], &format!("{what}.reference"))?,
         obstacles: &obstacles,
+        distance_cost_off: v["distance_cost_off"]
+            .as_u64()
+            .ok_or_else(|| format!("{what}.distance_cost_off: not an unsigned integer"))?,
         heading_floor,
     };
     Ok(MpcInput::of(&input))

@@ -200,6 +200,13 @@ pub struct TrackingParams {
     /// the encounter minus this margin
     /// ([`towing_mpc::ShipMpcParams::weight_port_turn`]).
     pub port_turn_margin: f64,
+    /// Largest rate (rad/s) at which the reference course turns
+    /// ([`Controller`](crate::Controller) docs, `docs/controller-design.md`,
+    /// "Reference course"); 0: no limit (the course jumps to the wanted one).
+    pub course_rate: f64,
+    /// Largest angle (rad) between the reference course and the ship's heading;
+    /// 0: no limit.
+    pub course_lead: f64,
 }
 
 impl Default for TrackingParams {
@@ -213,6 +220,8 @@ impl Default for TrackingParams {
             give_way_lookahead: 0.0,
             los_distance: 2.5,
             port_turn_margin: 2f64.to_radians(),
+            course_rate: 1.5f64.to_radians(),
+            course_lead: 20f64.to_radians(),
         }
     }
 }

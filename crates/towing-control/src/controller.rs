@@ -276,6 +276,8 @@ pub struct ControllerState {
     nu_end: [[f64; 3]; 2],
     fallbacks: u64,
     port_turn_anchor: [Option<f64>; MAX_OBSTACLES],
+    /// The reference course of the last sample.
+    course: Option<f64>,
     clock: Clock,
 }
 
@@ -302,6 +304,9 @@ pub struct Controller {
     /// Per obstacle slot: the ship's heading when an encounter began in which
     /// the tow may not turn to port ([`TrackingParams::port_turn_margin`]).
     port_turn_anchor: [Option<f64>; MAX_OBSTACLES],
+    /// The reference course of the last sample ([`TrackingParams::course_rate`]);
+    /// `None` before the first sample.
+    course: Option<f64>,
     clock: Clock,
     /// A copy of the last sample's MPC input ([`Controller::last_mpc_input`]).
     last_input: Option<MpcInput>,
@@ -369,6 +374,7 @@ impl Controller {
                 radius: 1.0,
             }; MAX_OBSTACLES],
             port_turn_anchor: [None; MAX_OBSTACLES],
+            course: None,
             clock: Clock {
                 // sample_time > 0 and finite (checked); at least 1 ns.
                 sample_ns: ((sample_time * 1e9).round() as i64).max(1),
@@ -397,6 +403,7 @@ impl Controller {
             fallbacks,
             mpc_obstacles: _,
             port_turn_anchor,
+            course,
             clock,
             last_input: _,
         } = self;
@@ -411,6 +418,7 @@ impl Controller {
             nu_end: *nu_end,
             fallbacks: *fallbacks,
             port_turn_anchor: *port_turn_anchor,
+            course: *course,
             clock: *clock,
         }
     }
@@ -449,6 +457,7 @@ impl Controller {
         self.nu_end = state.nu_end;
         self.fallbacks = state.fallbacks;
         self.port_turn_anchor = state.port_turn_anchor;
+        self.course = state.course;
         self.clock = state.clock;
         Ok(())
     }
@@ -488,13 +497,14 @@ impl Controller {
         let start = Instant::now();
         m.validate()?;
         let guided = self.guide(m)?;
-        let n_obstacles = self.select_obstacles(m);
+        let (n_obstacles, distance_cost_off) = self.select_obstacles(m);
         let input = SampleInput {
             ship: m.ship,
             tugs: m.tugs,
             previous: self.applied,
             reference: [guided.reference; HORIZON],
             obstacles: &self.mpc_obstacles[..n_obstacles],
+            distance_cost_off,
             heading_floor: guided.heading_floor,
         };
         self.last_input = Some(MpcInput::of(&input));
@@ -713,13 +723,15 @@ impl Controller {
     /// `lookahead = 0` the reference system's waypoint `eta_Sd` (eq. (8)-(11));
     /// otherwise the point `lookahead` metres ahead of the ship's projection on
     /// the active leg (previous waypoint to `target`, the altered one while
-    /// altered), continued onto the next leg past `target` (not while altered:
-    /// the next leg is the unaltered route, which leads back towards the
-    /// target), and the destination on the last leg (lookahead-based line of sight, Fossen 2011, section
+    /// altered), continued onto the next leg past `target`; while altered it runs
+    /// on along the altered leg instead (the next leg is the unaltered route, which
+    /// leads back towards the target, and homing onto the altered waypoint itself
+    /// made the tow crawl sideways and astern around it while giving way); and the
+    /// destination (altered or not) on the last leg (lookahead-based line of sight, Fossen 2011, section
     /// 10.3.2). The heading is the bearing from the ship to that point while it
     /// is farther than `los_distance`, else the point's route heading.
     fn reference(
-        &self,
+        &mut self,
         ship: &[f64; 6],
         active: usize,
         target: Pose,
@@ -737,10 +749,12 @@ impl Controller {
                 let e = [seg[0] / len, seg[1] / len];
                 let along = ((ship[0] - prev.x) * e[0] + (ship[1] - prev.y) * e[1]).clamp(0.0, len);
                 let remaining = len - along;
-                if remaining >= lookahead {
+                if remaining >= lookahead || (altered && active < last) {
+                    // An altered waypoint is a direction, not a place to stop at:
+                    // the point runs on past it along the altered leg.
                     let s = along + lookahead;
                     goal = [prev.x + s * e[0], prev.y + s * e[1], target.psi];
-                } else if active < last && !altered {
+                } else if active < last {
                     let next = points[active + 1];
                     let seg2 = [next.x - target.x, next.y - target.y];
                     let len2 = seg2[0].hypot(seg2[1]);
@@ -755,10 +769,61 @@ impl Controller {
                 }
             }
         }
+        self.steer(ship, goal)
+    }
+
+    /// The reference pose the MPC tracks, from the tracked point `goal`
+    /// (`docs/controller-design.md`, "Reference course"). The wanted course is the
+    /// line-of-sight bearing from the ship to `goal` while it is farther than
+    /// `los_distance`, else `goal`'s route heading; the reference course follows it
+    /// at most [`TrackingParams::course_rate`] per second (a bounded-rate reference,
+    /// so that a released alteration or a new leg never asks the tow to face up to
+    /// 95 deg off its heading at once, which the tugs answered by dragging the ship
+    /// sideways); it also stays within [`TrackingParams::course_lead`] of the
+    /// ship's heading, so it leads a turn the ship is making but never lies abeam.
+    /// Beyond `los_distance` the tracked position is moved onto the reference course,
+    /// at the range of `goal` but no farther than the lookahead (or `los_distance`,
+    /// the larger), so position and heading ask for the same motion: ahead along the
+    /// course at the cruise pull, never sideways, never faster for being far off.
+    /// Within `los_distance` the tracked position stays, less any part of it abaft
+    /// the ship's beam: the tow never gathers sternway to reach its reference.
+    fn steer(&mut self, ship: &[f64; 6], mut goal: [f64; 3]) -> [f64; 3] {
+        let t = &self.config.tuning;
         let (dx, dy) = (goal[0] - ship[0], goal[1] - ship[1]);
-        let los = self.config.tuning.tracking.los_distance;
-        if los > 0.0 && dx.hypot(dy) > los {
-            goal[2] = dy.atan2(dx);
+        let range = dx.hypot(dy);
+        let los = t.tracking.los_distance;
+        let far = los > 0.0 && range > los;
+        let wanted = if far { dy.atan2(dx) } else { goal[2] };
+        let step = t.tracking.course_rate * t.prediction.sample_time;
+        let mut course = match self.course {
+            Some(c) if step > 0.0 => wrap_angle(c + wrap_angle(wanted - c).clamp(-step, step)),
+            // The first sample turns from the ship's own heading.
+            None if step > 0.0 => {
+                let psi = ship[2];
+                wrap_angle(psi + wrap_angle(wanted - psi).clamp(-step, step))
+            }
+            _ => wanted,
+        };
+        let lead = t.tracking.course_lead;
+        if lead > 0.0 {
+            let psi = ship[2];
+            course = wrap_angle(psi + wrap_angle(course - psi).clamp(-lead, lead));
+        }
+        self.course = Some(course);
+        if far {
+            let (s, c) = course.sin_cos();
+            let reach = match t.tracking.lookahead {
+                l if l > 0.0 => range.min(l.max(los)),
+                _ => range,
+            };
+            goal = [ship[0] + reach * c, ship[1] + reach * s, course];
+        } else {
+            // Near: never a point abaft the ship's beam (no sternway to reach it, as
+            // the give-way slow-down's projection on the altered leg asked): its
+            // part astern of the ship is dropped, the part abeam kept.
+            let (s, c) = ship[2].sin_cos();
+            let astern = (dx * c + dy * s).min(0.0);
+            goal = [goal[0] - astern * c, goal[1] - astern * s, course];
         }
         goal
     }
@@ -772,7 +837,10 @@ impl Controller {
     /// (Rule 17(c)). In all three the tow therefore never turns to port: the
     /// heading at the start of the encounter, less
     /// [`TrackingParams::port_turn_margin`], is a floor for the ship's predicted
-    /// headings until the situation ends (the range opens). Without it the
+    /// headings until the target is past and clear (Rule 8(d); the guidance's
+    /// test) or the encounter ends. Held beyond past and clear, the floor
+    /// kept the ship's head to starboard while the reference course returned to
+    /// the route, and the tugs dragged her sideways (drift 100 deg). Without it the
     /// centralized MPC, trading the heading error against the tugs' distance
     /// terms of (16), let the stopped tow swing 40 deg to port while giving way
     /// to target A (`docs/controller-design.md`). Scheme III (distance cost
@@ -782,6 +850,7 @@ impl Controller {
         let mut floor: Option<f64> = None;
         for k in 0..MAX_OBSTACLES {
             let binding = alters
+                && !self.guidance.past_and_clear(k)
                 && matches!(
                     self.guidance.situation(k),
                     Some(
@@ -852,8 +921,10 @@ impl Controller {
     }
 
     /// Copies the nearest obstacles (by range from the tow) into the MPC's list;
-    /// returns how many.
-    fn select_obstacles(&mut self, m: &Measurement) -> usize {
+    /// returns how many, and which of them the distance cost leaves out: in schemes
+    /// I and II, the targets the tow stands on until Rule 17 allows action
+    /// ([`towing_guidance::ReferenceSystem::stands_on`]; their clearance rows stay).
+    fn select_obstacles(&mut self, m: &Measurement) -> (usize, u64) {
         let t = &self.config.tuning;
         let slots = t
             .ship
@@ -883,10 +954,15 @@ impl Controller {
         }
         candidates[..n].sort_by(|a, b| a.0.total_cmp(&b.0));
         let used = n.min(slots);
+        let mut off = 0u64;
+        let alters = self.config.tuning.scheme.alters();
         for (j, &(_, k)) in candidates[..used].iter().enumerate() {
             self.mpc_obstacles[j] = mpc_obstacle(&m.obstacles[k], ts);
+            if alters && self.guidance.stands_on(k) {
+                off |= 1 << j;
+            }
         }
-        used
+        (used, off)
     }
 
     fn prediction(&self, m: &Measurement, from_plan: bool) -> Prediction {

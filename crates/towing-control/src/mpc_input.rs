@@ -28,6 +28,9 @@ pub struct MpcInput {
     obstacles: [Obstacle; MAX_OBSTACLES],
     /// How many of `obstacles` are in use.
     n_obstacles: usize,
+    /// The obstacles left out of the distance cost
+    /// ([`SampleInput::distance_cost_off`]).
+    pub distance_cost_off: u64,
     /// The heading floor (rad), if any.
     pub heading_floor: Option<f64>,
 }
@@ -57,6 +60,7 @@ impl MpcInput {
             reference: input.reference,
             obstacles,
             n_obstacles: n,
+            distance_cost_off: input.distance_cost_off,
             heading_floor: input.heading_floor,
         }
     }
@@ -76,6 +80,7 @@ impl MpcInput {
             previous: self.previous,
             reference: self.reference,
             obstacles: self.obstacles(),
+            distance_cost_off: self.distance_cost_off,
             heading_floor: self.heading_floor,
         }
     }
@@ -109,6 +114,7 @@ mod tests {
             },
             reference: [[3.0, 4.0, 0.6]; HORIZON],
             obstacles: &obstacles,
+            distance_cost_off: 0b10,
             heading_floor: Some(0.2),
         };
         let owned = MpcInput::of(&input);
@@ -119,5 +125,6 @@ mod tests {
             (input.ship, input.tugs, input.previous, input.reference)
         );
         assert_eq!(back.heading_floor, Some(0.2));
+        assert_eq!(back.distance_cost_off, 0b10);
     }
 }

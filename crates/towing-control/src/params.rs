@@ -179,7 +179,7 @@ pub static PARAMETERS: &[Parameter] = &[
     Parameter {
         name: "mpc.ship.weight_heading",
         old_name: Some("w_S1"),
-        description: "Coordination (ship) MPC: weight of the heading error in eq. (13); 1 as Du et al. 2022, Table 3",
+        description: "Coordination (ship) MPC: weight of the heading error in eq. (13); 10 (Du et al. 2022, Table 3: 1), so that the ship turns to her reference course rather than being dragged sideways (docs/assumptions.md)",
         kind: Kind::Real {
             unit: "1/rad2",
             min: Limit::AtLeast(0.0),
@@ -270,6 +270,54 @@ pub static PARAMETERS: &[Parameter] = &[
             max: Limit::None,
             get: |t| t.ship.weight_port_turn,
             set: |t, v| t.ship.weight_port_turn = v,
+        },
+    },
+    Parameter {
+        name: "mpc.ship.max_drift",
+        old_name: None,
+        description: "Soft limit of the ship's predicted drift angle: |v| <= tan(max_drift) u + 0.005 m/s (seamanship, docs/colregs.md); 22 deg, inside the 30 deg bound (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "rad",
+            min: Limit::Above(0.0),
+            max: Limit::Below(std::f64::consts::FRAC_PI_2),
+            get: |t| t.ship.motion.max_drift,
+            set: |t, v| t.ship.motion.max_drift = v,
+        },
+    },
+    Parameter {
+        name: "mpc.ship.max_sternway",
+        old_name: None,
+        description: "Soft limit of the ship's predicted surge astern; 0.01 m/s, inside the 0.03 m/s bound (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "m/s",
+            min: Limit::AtLeast(0.0),
+            max: Limit::None,
+            get: |t| t.ship.motion.max_sternway,
+            set: |t, v| t.ship.motion.max_sternway = v,
+        },
+    },
+    Parameter {
+        name: "mpc.ship.max_speed",
+        old_name: None,
+        description: "Soft limit of the ship's predicted surge ahead; 0.11 m/s, about 1.2 times the tow's cruise (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "m/s",
+            min: Limit::Above(0.0),
+            max: Limit::None,
+            get: |t| t.ship.motion.max_speed,
+            set: |t, v| t.ship.motion.max_speed = v,
+        },
+    },
+    Parameter {
+        name: "mpc.ship.motion_penalty",
+        old_name: None,
+        description: "Exact L1 penalty on the slack of the motion limits (drift, sternway, speed); 1e4 as the clearance rows; 0 turns the limits off",
+        kind: Kind::Real {
+            unit: "s/m",
+            min: Limit::AtLeast(0.0),
+            max: Limit::None,
+            get: |t| t.ship.motion.penalty,
+            set: |t, v| t.ship.motion.penalty = v,
         },
     },
     Parameter {
@@ -682,6 +730,30 @@ pub static PARAMETERS: &[Parameter] = &[
             max: Limit::Below(std::f64::consts::FRAC_PI_2),
             get: |t| t.tracking.port_turn_margin,
             set: |t, v| t.tracking.port_turn_margin = v,
+        },
+    },
+    Parameter {
+        name: "tracking.course_rate",
+        old_name: None,
+        description: "Largest rate at which the reference course turns towards the line of sight to the tracked point, whose position is kept on that course (no sideways or astern reference after an alteration is released); 1.5 deg/s, about the yaw rate the tow reaches in the paper's alterations (docs/assumptions.md); 0: no limit",
+        kind: Kind::Real {
+            unit: "rad/s",
+            min: Limit::AtLeast(0.0),
+            max: Limit::Below(std::f64::consts::PI),
+            get: |t| t.tracking.course_rate,
+            set: |t, v| t.tracking.course_rate = v,
+        },
+    },
+    Parameter {
+        name: "tracking.course_lead",
+        old_name: None,
+        description: "Largest angle between the reference course and the ship's heading: the tracked point leads a turn the ship is making but never lies abeam of her (seamanship: drift angle under 30 deg); 20 deg (docs/assumptions.md); 0: no limit",
+        kind: Kind::Real {
+            unit: "rad",
+            min: Limit::AtLeast(0.0),
+            max: Limit::Below(std::f64::consts::PI),
+            get: |t| t.tracking.course_lead,
+            set: |t, v| t.tracking.course_lead = v,
         },
     },
     Parameter {

@@ -164,6 +164,9 @@ fn scheme_three_tracks_the_unaltered_route_and_scheme_two_drops_the_distance_cos
         config.tuning.scheme = scheme;
         config.tuning.tracking.lookahead = 0.0;
         config.tuning.tracking.los_distance = 0.0;
+        // The reference as the scheme gives it, not turned at a bounded rate.
+        config.tuning.tracking.course_rate = 0.0;
+        config.tuning.tracking.course_lead = 0.0;
         let mut c = Controller::new(config).unwrap();
         c.sample(&m).unwrap()
     };
@@ -175,6 +178,34 @@ fn scheme_three_tracks_the_unaltered_route_and_scheme_two_drops_the_distance_cos
     assert_ne!(one.reference, three.reference);
     assert_eq!(one.situation[3], Some(Situation::HeadOn));
     assert_eq!(one.role[3], Some(Role::GiveWay));
+}
+
+/// The ship 4 m to port of her first leg, heading along it: the line of sight to the
+/// tracked point lies about 50 deg to starboard. The reference course turns towards it
+/// by at most `course_rate * T_s` per sample, stays within `course_lead` of the
+/// heading, and the tracked point lies on the reference course ahead of the ship.
+#[test]
+fn the_reference_course_turns_at_a_bounded_rate_and_carries_the_tracked_point() {
+    let (scenario, mut m) = paper_measurement();
+    let config = ControllerConfig::new(scenario);
+    let t = config.tuning.tracking;
+    let step = t.course_rate * config.tuning.prediction.sample_time;
+    let psi = m.ship[2];
+    // 4 m to port of the leg (port of a heading psi is psi - 90 deg).
+    m.ship[0] += 4.0 * (psi - std::f64::consts::FRAC_PI_2).cos();
+    m.ship[1] += 4.0 * (psi - std::f64::consts::FRAC_PI_2).sin();
+    let mut c = Controller::new(config).unwrap();
+    let mut previous = psi;
+    for k in 0..5 {
+        let r = c.sample(&m).unwrap().reference;
+        let turn = towing_model::wrap_angle(r[2] - previous);
+        assert!(turn > 0.0 && turn <= step + 1e-12, "sample {k}: turned {turn} rad");
+        assert!(towing_model::wrap_angle(r[2] - psi).abs() <= t.course_lead + 1e-12);
+        let (dx, dy) = (r[0] - m.ship[0], r[1] - m.ship[1]);
+        assert!((dy.atan2(dx) - r[2]).abs() < 1e-9, "the point lies on the course");
+        assert!(dx.hypot(dy) <= t.lookahead.max(t.los_distance) + 1e-9);
+        previous = r[2];
+    }
 }
 
 #[test]

@@ -355,6 +355,33 @@ pub fn classify(
     }
 }
 
+/// The situation the tow acts on: the classified one, or where the sectors leave a gap
+/// ([`Situation::Unclassified`]) the safe reading of it (`docs/colregs.md`, "Gaps
+/// between the sectors"). Risk of collision is deemed to exist (Rule 7(a): "if there is
+/// any doubt such risk shall be deemed to exist"), so a closing target never stays
+/// without a situation and an action:
+/// - own ship more than `beam_sector` abaft the target's beam: own ship is overtaking
+///   (Rule 13(c): "when a vessel is in any doubt as to whether she is overtaking
+///   another, she shall assume that this is the case");
+/// - the target more than `beam_sector` abaft own beam: the target comes up from
+///   astern, so own ship is being overtaken and stands on (Rules 13, 17);
+/// - otherwise the target is forward of own beam: own ship gives way (Rules 15 and 16
+///   give way to the vessel on the own starboard side; for one whose side is in doubt,
+///   keeping out of its way by a starboard alteration and slackening is what Rule 17(c)
+///   still allows and what Rule 8 asks of an action taken in doubt).
+#[must_use]
+pub fn safe_reading(encounter: &Encounter, thresholds: &EncounterThresholds) -> Situation {
+    if encounter.situation != Situation::Unclassified {
+        encounter.situation
+    } else if encounter.contact_angle.abs() > thresholds.beam_sector {
+        Situation::Overtaking
+    } else if encounter.bearing.abs() > thresholds.beam_sector {
+        Situation::BeingOvertaken
+    } else {
+        Situation::CrossingGiveWay
+    }
+}
+
 /// How the tow counts under the COLREGS.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 pub enum TowStatus {
@@ -591,6 +618,41 @@ mod tests {
 
     fn xu() -> EncounterThresholds {
         ThresholdPreset::Xu.thresholds()
+    }
+
+    #[test]
+    fn the_safe_reading_closes_every_gap_between_the_sectors() {
+        let th = EncounterThresholds::default();
+        let read_at = |beta: f64, alpha: f64, speed: f64| {
+            let e = encounter_with(beta, alpha, speed, 5.0, &th);
+            assert!(e.cpa.is_closing(), "{beta} {alpha} {speed}: {e:?}");
+            (e.situation, safe_reading(&e, &th))
+        };
+        let read = |beta: f64, alpha: f64| read_at(beta, alpha, 0.07);
+        // Heading straight at own ship from 20 deg on the starboard bow: give way.
+        assert_eq!(
+            read(20.0, 0.0),
+            (Situation::Unclassified, Situation::CrossingGiveWay)
+        );
+        // The same from the port bow: in doubt, give way too.
+        assert_eq!(
+            read(-30.0, 9.9),
+            (Situation::Unclassified, Situation::CrossingGiveWay)
+        );
+        // Own ship abaft the target's beam, bearing 60 deg (no overtaking sector):
+        // Rule 13(c), own ship overtakes.
+        assert_eq!(
+            read_at(60.0, -150.0, 0.03),
+            (Situation::Unclassified, Situation::Overtaking)
+        );
+        // The target abaft own beam, contact angle 60 deg: it is overtaking.
+        assert_eq!(
+            read_at(150.0, 60.0, 0.2),
+            (Situation::Unclassified, Situation::BeingOvertaken)
+        );
+        // A classified situation is its own reading.
+        let e = encounter_with(0.0, 0.0, 0.07, 5.0, &th);
+        assert_eq!(safe_reading(&e, &th), e.situation);
     }
 
     #[test]

@@ -52,7 +52,7 @@ pub mod reference;
 pub mod waypoint;
 
 pub use colregs::{
-    action, classify, role, Action, ColregsSettings, Encounter, EncounterThresholds, Manoeuvre,
+    action, classify, role, safe_reading, Action, ColregsSettings, Encounter, EncounterThresholds, Manoeuvre,
     Role, Rule17Settings, Situation, ThresholdPreset, TowStatus,
 };
 pub use distance::{ActiveObstacle, Ellipse};
@@ -60,7 +60,7 @@ pub use error::{InputError, ParamError};
 pub use geometry::{body_to_ned, cpa, relative_bearing, wrap_angle, Cpa};
 pub use params::{GuidanceParams, GuidanceSettings, StaticHazardPolicy};
 pub use reference::{
-    assess_obstacle, AssessContext, GuidanceOutput, ObstacleAssessment, ReferenceSystem, TowState,
-    TowVessel,
+    assess_obstacle, AssessContext, GuidanceOutput, ObstacleAssessment, ReferenceSystem, Sighting,
+    TowState, TowVessel,
 };
 pub use waypoint::{rotate_waypoint, theta_max, Route};

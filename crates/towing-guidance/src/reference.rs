@@ -41,7 +41,7 @@ use serde::{Deserialize, Serialize};
 
 use towing_model::{ObstacleKind, ObstacleSlot, Pose, MAX_OBSTACLES};
 
-use crate::colregs::{action, classify, Action, Encounter, Manoeuvre, Situation};
+use crate::colregs::{action, classify, safe_reading, Action, Encounter, Manoeuvre, Situation};
 use crate::distance::ActiveObstacle;
 use crate::error::InputError;
 use crate::geometry::{dist, segment_distance};
@@ -134,6 +134,9 @@ pub struct ObstacleAssessment {
     /// of the tow is opening and exceeds that vessel's eq. (14) safe range plus
     /// `release_margin` (see [`past_and_clear`]). Always false for a static hazard.
     pub past_and_clear: bool,
+    /// The target has crossed the ship's heading line ahead of her by its own motion
+    /// at this sample or earlier in the encounter ([`AssessContext::crossed`]).
+    pub crossed: bool,
     /// What it asks of the reference system now (detection, Rule 17 and
     /// `past_and_clear` applied).
     pub manoeuvre: Manoeuvre,
@@ -153,6 +156,37 @@ pub struct AssessContext {
     /// not ended since (ignored for static hazards): it stays over unless the target
     /// closes again into a close-quarters situation (see [`past_and_clear`]).
     pub cleared: bool,
+    /// Where the ship and this target were at the previous sample (ignored for static
+    /// hazards): the line the target must cross by its own motion ([`Sighting`]).
+    pub previous: Option<Sighting>,
+    /// This target has crossed the ship's heading line ahead of her by its own motion
+    /// since its encounter began (ignored for static hazards).
+    pub crossed: bool,
+}
+
+/// The ship's pose and a target's position at one sample: the next sample tells from
+/// it whether the target crossed the ship's heading line ahead of her by its own
+/// motion (the line is the one through the ship's pose of this sample, held still, so
+/// neither the tow's turn nor its sideways motion can make the crossing).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Sighting {
+    /// Ship pose.
+    pub ship: Pose,
+    /// Target centre (m).
+    pub target: [f64; 2],
+}
+
+impl Sighting {
+    /// True when `target_now` lies on the other side of this sighting's heading line
+    /// than the target did, and ahead of the ship.
+    #[must_use]
+    pub fn crossed_ahead(&self, target_now: [f64; 2]) -> bool {
+        let (s, c) = self.ship.psi.sin_cos();
+        let side = |p: [f64; 2]| -(p[0] - self.ship.x) * s + (p[1] - self.ship.y) * c;
+        let along = (target_now[0] - self.ship.x) * c + (target_now[1] - self.ship.y) * s;
+        let before = side(self.target);
+        before != 0.0 && before * side(target_now) <= 0.0 && along > 0.0
+    }
 }
 
 /// Assesses one active obstacle for the tow (steps 1 and 2 of the module doc).
@@ -194,7 +228,9 @@ pub fn assess_obstacle(
                 &s.colregs.thresholds,
                 s.colregs.risk_dcpa,
             );
-            let situation = context.held.unwrap_or(enc.situation);
+            let situation = context
+                .held
+                .unwrap_or_else(|| safe_reading(&enc, &s.colregs.thresholds));
             (
                 Some(enc),
                 Some(situation),
@@ -212,9 +248,13 @@ pub fn assess_obstacle(
         ) => segment_distance(*centre, leg[0], leg[2]) > segment_distance(*centre, leg[0], leg[1]),
         _ => true,
     };
-    let past_and_clear = encounter.is_some_and(|enc| {
+    let crossed = context.crossed
+        || context
+            .previous
+            .is_some_and(|p| p.crossed_ahead(obstacle.centre()));
+    let past_and_clear = encounter.zip(situation).is_some_and(|(enc, situation)| {
         (context.cleared && !s.colregs.rule17.give_way_failed(&enc.cpa))
-            || past_and_clear(params, tow, &vessels, obstacle)
+            || past_and_clear(params, tow, &vessels, obstacle, (situation, crossed))
     });
     let manoeuvre = match (
         detected && alteration_allowed && !past_and_clear,
@@ -237,31 +277,47 @@ pub fn assess_obstacle(
         detected,
         alteration_allowed,
         past_and_clear,
+        crossed,
         manoeuvre,
     }
 }
 
-/// Whether `obstacle`, a target ship, is past and clear of the tow (false for a static hazard) (COLREGS Rule 8(d): the
-/// give-way action lasts "until the other vessel is finally past and clear"): for every
-/// vessel of the tow (position `p`, length `l`) the range is opening,
-/// `(p_target - p) . (v_target - v_ship) > 0`, and the range-equivalent distance exceeds
-/// the eq. (14) safe range `L + a_j + d_S0` plus `release_margin`. The tugs are taken
-/// to move with the ship (they hold the formation of eq. (4)-(6)); their own velocity is
-/// not among the guidance's inputs.
+/// Whether `obstacle`, a target ship, is past and clear of the tow (false for a static
+/// hazard) (COLREGS Rule 8(d): the give-way action lasts "until the other vessel is
+/// finally past and clear"), judged from the target's own motion relative to the tow,
+/// never from a range opened by the tow's own braking (`docs/colregs.md`, "Past and
+/// clear"):
+/// - where it is: in a crossing (any situation but head-on and the two overtaking ones)
+///   the target has crossed the ship's heading line ahead of her by its own motion
+///   (`crossed`, [`Sighting::crossed_ahead`]); in any situation it may instead be abaft
+///   the ship's beam (`|beta| > 90 deg`). A head-on or overtaking target moves along the
+///   tow's track, not across it, so only the second applies to it;
+/// - and for every vessel of the tow (position `p`, length `l`) the range is opening,
+///   `(p_target - p) . (v_target - v_ship) > 0`, and the range-equivalent distance
+///   exceeds the eq. (14) safe range `L + a_j + d_S0` plus `release_margin`. The tugs
+///   are taken to move with the ship (they hold the formation of eq. (4)-(6)); their own
+///   velocity is not among the guidance's inputs.
 fn past_and_clear(
     params: &GuidanceParams,
     tow: &TowState,
     vessels: &[(TowVessel, [f64; 2], f64); 3],
     obstacle: &ActiveObstacle,
+    (situation, crossed): (Situation, bool),
 ) -> bool {
     let ActiveObstacle::Vessel(target) = obstacle else {
         return false;
     };
     let s = params.settings();
-    let v_target = [
-        target.speed * target.psi.cos(),
-        target.speed * target.psi.sin(),
-    ];
+    let along_track = matches!(
+        situation,
+        Situation::HeadOn | Situation::Overtaking | Situation::BeingOvertaken
+    );
+    let beta = crate::geometry::relative_bearing(tow.ship.x, tow.ship.y, tow.ship.psi, target.centre);
+    let abaft = beta.abs() > std::f64::consts::FRAC_PI_2;
+    if !(abaft || (crossed && !along_track)) {
+        return false;
+    }
+    let v_target = target.velocity();
     let dv = [
         v_target[0] - tow.ship_vel_n[0],
         v_target[1] - tow.ship_vel_n[1],
@@ -272,6 +328,15 @@ fn past_and_clear(
         opening
             && obstacle.range(p) > obstacle.safe_range(length, s.safety_buffer) + s.release_margin
     })
+}
+
+/// The tow stands on for this assessment's target (see [`ReferenceSystem::stands_on`]).
+fn stands_on(params: &GuidanceParams, a: &ObstacleAssessment) -> bool {
+    let rule17 = &params.settings().colregs.rule17;
+    matches!(a.action, Action::StandOn | Action::StandOnThenAct)
+        && a.manoeuvre == Manoeuvre::FollowRoute
+        && !a.past_and_clear
+        && a.encounter.is_some_and(|e| !rule17.give_way_failed(&e.cpa))
 }
 
 /// Output of one sample.
@@ -333,8 +398,15 @@ pub struct ReferenceSystem {
     active: usize,
     latched: u64,
     cleared: u64,
+    crossed: u64,
+    /// Per slot: past and clear at the last sample.
+    past: u64,
+    /// Per slot: a target the tow stands on at the last sample, Rule 17 not yet
+    /// allowing action.
+    standing_on: u64,
     held: [Option<Situation>; MAX_OBSTACLES],
     situations: [Option<Situation>; MAX_OBSTACLES],
+    sightings: [Option<Sighting>; MAX_OBSTACLES],
 }
 
 impl ReferenceSystem {
@@ -347,8 +419,12 @@ impl ReferenceSystem {
             active: 1,
             latched: 0,
             cleared: 0,
+            crossed: 0,
+            past: 0,
+            standing_on: 0,
             held: [None; MAX_OBSTACLES],
             situations: [None; MAX_OBSTACLES],
+            sightings: [None; MAX_OBSTACLES],
         }
     }
 
@@ -379,8 +455,12 @@ impl ReferenceSystem {
         self.active = 1;
         self.latched = 0;
         self.cleared = 0;
+        self.crossed = 0;
+        self.past = 0;
+        self.standing_on = 0;
         self.held = [None; MAX_OBSTACLES];
         self.situations = [None; MAX_OBSTACLES];
+        self.sightings = [None; MAX_OBSTACLES];
     }
 
     /// The route.
@@ -408,6 +488,23 @@ impl ReferenceSystem {
     #[must_use]
     pub fn situation(&self, slot: usize) -> Option<Situation> {
         self.situations.get(slot).copied().flatten()
+    }
+
+    /// True when the target ship in slot `slot` was past and clear at the last
+    /// [`update`](Self::update) ([`ObstacleAssessment::past_and_clear`]).
+    #[must_use]
+    pub fn past_and_clear(&self, slot: usize) -> bool {
+        slot < MAX_OBSTACLES && self.past & (1 << slot) != 0
+    }
+
+    /// True when the tow stands on for the target ship in slot `slot` at the last
+    /// [`update`](Self::update): its policy is to keep course and speed
+    /// ([`Action::StandOn`], [`Action::StandOnThenAct`]), it is neither past and
+    /// clear nor at close quarters (Rule 17(a)(ii), (b): the TCPA and DCPA limits of
+    /// [`crate::Rule17Settings`]), and the route is kept for it.
+    #[must_use]
+    pub fn stands_on(&self, slot: usize) -> bool {
+        slot < MAX_OBSTACLES && self.standing_on & (1 << slot) != 0
     }
 
     /// True while an encounter keeps the route altered.
@@ -479,8 +576,12 @@ impl ReferenceSystem {
         let mut nearest_latched: Option<ObstacleAssessment> = None;
         let mut latched = 0u64;
         let mut cleared = 0u64;
+        let mut crossed = 0u64;
+        let mut past = 0u64;
+        let mut standing_on = 0u64;
         let mut held = [None; MAX_OBSTACLES];
         let mut situations = [None; MAX_OBSTACLES];
+        let mut sightings = [None; MAX_OBSTACLES];
         let points = self.route.points();
         let leg = [
             points[self.active - 1].position(),
@@ -500,6 +601,8 @@ impl ReferenceSystem {
                 held: held_before,
                 leg: Some(leg),
                 cleared: self.cleared & bit != 0,
+                previous: self.sightings[index],
+                crossed: self.crossed & bit != 0,
             };
             let a = assess_obstacle(&self.params, tow, index, &obstacle, &context);
             situations[index] = a.situation;
@@ -512,9 +615,22 @@ impl ReferenceSystem {
                 _ => s.detection_distance,
             };
             let in_encounter = a.range <= detection + s.release_margin;
-            if let (true, Some(enc)) = (in_encounter, a.encounter) {
-                let definite = !matches!(enc.situation, Situation::Safe | Situation::Unclassified);
-                held[index] = held_before.or((a.detected && definite).then_some(enc.situation));
+            if a.past_and_clear {
+                past |= bit;
+            }
+            if in_encounter && stands_on(&self.params, &a) {
+                standing_on |= bit;
+            }
+            if let (true, Some(situation)) = (in_encounter, a.situation) {
+                let definite = situation != Situation::Safe;
+                held[index] = held_before.or((a.detected && definite).then_some(situation));
+                sightings[index] = Some(Sighting {
+                    ship: tow.ship,
+                    target: obstacle.centre(),
+                });
+                if a.crossed {
+                    crossed |= bit;
+                }
             }
             // An encounter found past and clear stays over until it ends (or a new
             // close-quarters situation arises, in `assess_obstacle`): the tow's own
@@ -536,8 +652,12 @@ impl ReferenceSystem {
         }
         self.latched = latched;
         self.cleared = cleared;
+        self.crossed = crossed;
+        self.past = past;
+        self.standing_on = standing_on;
         self.held = held;
         self.situations = situations;
+        self.sightings = sightings;
         let altered = latched != 0;
 
         let ship = tow.ship.position();
@@ -755,6 +875,83 @@ mod tests {
         let overtaking = [vessel(tow.tug1.x - 3.0, 0.0, 0.0, 0.3)];
         let g = rs.update(&tow, &overtaking).unwrap().governing.unwrap();
         assert!(!g.past_and_clear);
+    }
+
+    /// A give-way tow with the way off (at rest, heading North) and a crossing target
+    /// on its starboard bow whose range opens by its own motion (it heads away
+    /// north-east) but which has not crossed ahead: not past (the old test, an
+    /// opening range beyond the safe range, released it). Once it has crossed the
+    /// ship's heading line ahead of her, westbound, it is past and clear.
+    #[test]
+    fn a_crossing_target_is_past_only_once_it_has_crossed_ahead_by_its_own_motion() {
+        let tow = tow_at(Pose::new(0.0, 0.0, 0.0), 0.0);
+        let params = GuidanceParams::default();
+        let mut rs = ReferenceSystem::new(north_route(), params);
+        // Crossing give-way: on the starboard bow, heading West across the bow.
+        let crossing = vessel(5.5, 4.0, -PI / 2.0, 0.07);
+        let out = rs.update(&tow, &[crossing]).unwrap();
+        assert!(out.altered);
+        assert_eq!(
+            out.governing.unwrap().situation,
+            Some(Situation::CrossingGiveWay)
+        );
+        // The same target now heading away north-east: the range opens by its own
+        // motion, it is beyond every safe range, but it is still forward of the beam
+        // on the starboard bow and has not crossed: the alteration holds.
+        let away = vessel(5.5, 4.0, PI / 4.0, 0.07);
+        let out = rs.update(&tow, &[away]).unwrap();
+        let g = out.governing.unwrap();
+        assert!(!g.past_and_clear && !g.crossed, "{g:?}");
+        assert!(out.altered);
+        // Westbound across the bow: at 5.5 m ahead it goes from starboard (y = 0.05)
+        // to port (y = -0.05): crossed ahead by its own motion, and clear.
+        let before = vessel(6.5, 0.05, -PI / 2.0, 0.07);
+        let after = vessel(6.5, -0.05, -PI / 2.0, 0.07);
+        rs.update(&tow, &[before]).unwrap();
+        let g = rs.update(&tow, &[after]).unwrap().governing.unwrap();
+        assert!(g.crossed);
+        // 6.5 m ahead of the ship is about 4.4 m ahead of tug 2: clear of every safe range.
+        assert!(g.past_and_clear, "{g:?}");
+    }
+
+    /// The sectors' gap: a closing target 40 deg on the starboard bow heading straight
+    /// at the ship (contact angle 0) is unclassified by the Woerner sectors; the tow
+    /// acts on its safe reading, crossing give-way, and alters at once.
+    #[test]
+    fn an_unclassified_target_forward_of_the_beam_is_given_way_to() {
+        let tow = tow_at(Pose::new(0.0, 0.0, 0.0), 0.1);
+        let beta = 40f64.to_radians();
+        let (x, y) = (6.0 * beta.cos(), 6.0 * beta.sin());
+        let target = vessel(x, y, (-y).atan2(-x), 0.05);
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let out = rs.update(&tow, &[target]).unwrap();
+        let g = out.governing.unwrap();
+        assert_eq!(g.encounter.unwrap().situation, Situation::Unclassified);
+        assert_eq!(g.situation, Some(Situation::CrossingGiveWay));
+        assert!(out.altered);
+    }
+
+    /// A target overtaking the tow from astern: the tow stands on (Rule 17(a)(i)), so
+    /// the controller leaves it out of the distance cost, until close quarters
+    /// (TCPA <= 30 s and DCPA < 2.5 m), when Rule 17(b) lets the tow act.
+    #[test]
+    fn the_tow_stands_on_for_an_overtaking_target_until_close_quarters() {
+        let tow = tow_at(Pose::new(0.0, 0.0, 0.0), 0.05);
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        // 6 m astern, 2 m to starboard, northbound at 0.12 m/s: DCPA 2 m, TCPA 86 s.
+        let far = vessel(-6.0, 2.0, 0.0, 0.12);
+        let out = rs.update(&tow, &[far]).unwrap();
+        assert_eq!(
+            out.governing.unwrap().situation,
+            Some(Situation::BeingOvertaken)
+        );
+        assert!(!out.altered && rs.stands_on(0));
+        // 2.5 m astern: TCPA 36 s, still standing on; 1.5 m astern: TCPA 21 s.
+        assert!(!rs.update(&tow, &[vessel(-2.5, 2.0, 0.0, 0.12)]).unwrap().altered);
+        assert!(rs.stands_on(0));
+        rs.update(&tow, &[vessel(-1.5, 2.0, 0.0, 0.12)]).unwrap();
+        assert!(!rs.stands_on(0));
+        assert!(!rs.stands_on(1) && !rs.stands_on(MAX_OBSTACLES));
     }
 
     #[test]

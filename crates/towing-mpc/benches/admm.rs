@@ -46,6 +46,7 @@ fn bench(c: &mut Criterion) {
             previous: AppliedCommand::default(),
             reference,
             obstacles: &obstacles,
+            distance_cost_off: 0,
             heading_floor: None,
         };
         let mut admm = Admm::from_scenario(
@@ -89,6 +90,7 @@ fn bench(c: &mut Criterion) {
             previous: AppliedCommand::default(),
             reference,
             obstacles,
+            distance_cost_off: 0,
             heading_floor: None,
         };
         let mut central = Centralized::from_scenario(

@@ -38,6 +38,7 @@ fn bench(c: &mut Criterion) {
         lambda: [[0.1, -0.1, 0.0]; HORIZON],
         rho: 1.0,
         obstacles: &obstacles,
+        distance_cost_off: 0,
     };
     let tug_plan = [[1.0, 0.0, 0.0]; HORIZON];
     c.bench_function("tug_scp_step", |b| {
@@ -74,6 +75,7 @@ fn bench(c: &mut Criterion) {
         lambda: [[[0.05; 3]; HORIZON]; 2],
         rho: 1.0,
         obstacles: &obstacles,
+        distance_cost_off: 0,
         heading_floor: None,
     };
     let ship_plan = [[0.5, 1.0, 0.0, 0.0]; HORIZON];

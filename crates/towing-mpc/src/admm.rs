@@ -201,6 +201,11 @@ pub struct SampleInput<'a> {
     pub reference: [[f64; 3]; HORIZON],
     /// Static obstacles.
     pub obstacles: &'a [Obstacle],
+    /// Obstacles left out of the distance cost `phi` (bit `j` for `obstacles[j]`);
+    /// their clearance rows stay. The controller sets it for the targets the tow
+    /// stands on (COLREGS Rule 17(a)(i): keep course and speed) until Rule 17 allows
+    /// action: pushed off by `phi`, the tow turned away from a vessel overtaking it.
+    pub distance_cost_off: u64,
     /// The lowest heading the ship may take over the horizon (rad): COLREGS,
     /// no turn to port while giving way or standing on
     /// ([`crate::ShipMpcParams::port_turn_weight`]); `None`: no such limit.
@@ -553,6 +558,7 @@ impl Core<'_> {
                 lambda: *self.lambda,
                 rho: self.settings.rho,
                 obstacles: input.obstacles,
+                distance_cost_off: input.distance_cost_off,
                 heading_floor: input.heading_floor,
             });
             last_steps = [steps[0], steps[1], ship];
@@ -618,6 +624,7 @@ impl Core<'_> {
             lambda: self.lambda[i],
             rho: self.settings.rho,
             obstacles: input.obstacles,
+            distance_cost_off: input.distance_cost_off,
         };
         self.tug2.start(&data(1));
         let first = self.tug1.step(&data(0));

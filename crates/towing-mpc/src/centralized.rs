@@ -317,16 +317,19 @@ pub struct CentralLinearised {
 pub struct CentralRows {
     consensus: PairRows,
     clearance: [SlotRows; 3],
+    motion: SlotRows,
 }
 
 impl RowSet for CentralRows {
     fn blocks(&self) -> impl Iterator<Item = Block<'_>> {
         std::iter::once(Block::Pairs(&self.consensus))
             .chain(self.clearance.iter().map(Block::Slots))
+            .chain(std::iter::once(Block::Slots(&self.motion)))
     }
     fn blocks_mut(&mut self) -> impl Iterator<Item = BlockMut<'_>> {
         std::iter::once(BlockMut::Pairs(&mut self.consensus))
             .chain(self.clearance.iter_mut().map(BlockMut::Slots))
+            .chain(std::iter::once(BlockMut::Slots(&mut self.motion)))
     }
 }
 
@@ -403,7 +406,7 @@ impl CentralProblem {
         }
     }
 
-    /// The ship's terms of sample `h` (with its clearance rows).
+    /// The ship's terms of sample `h` (with its clearance and motion rows).
     #[allow(clippy::too_many_arguments)] // the pieces of one stage; one call site
     fn ship_terms(
         &self,
@@ -412,9 +415,13 @@ impl CentralProblem {
         u: &ShipInput,
         h: usize,
         rows: &[[f64; NU]; 6],
-        clearance: Option<&mut SlotRows>,
+        soft: Option<&mut CentralRows>,
         input: &SampleInput<'_>,
     ) {
+        let (clearance, motion) = match soft {
+            Some(r) => (Some(&mut r.clearance[0]), Some(&mut r.motion)),
+            None => (None, None),
+        };
         let sp = &self.ship_params;
         ship_stage_terms(
             quad,
@@ -429,9 +436,11 @@ impl CentralProblem {
             h + 1 == HORIZON,
             input.heading_floor,
         );
+        sp.motion.terms(quad, motion, h, x, rows);
         obstacle_terms(
             quad,
             input.obstacles,
+            input.distance_cost_off,
             &sp.distance,
             sp.weight_distance,
             &sp.clearance,
@@ -466,8 +475,8 @@ impl CentralProblem {
             let start = quad.value;
             let rows = sens.map_or(zero, |s| sens_rows(&s.ship[h]));
             let x = &traj.ship[h];
-            let clearance = rows_out.as_deref_mut().map(|r| &mut r.clearance[0]);
-            self.ship_terms(quad, x, &plan.ship[h], h, &rows, clearance, input);
+            let soft = rows_out.as_deref_mut();
+            self.ship_terms(quad, x, &plan.ship[h], h, &rows, soft, input);
             out.ship += quad.value - start;
             // The tugs.
             let eta_s = [x[0], x[1], x[2]];
@@ -517,6 +526,7 @@ impl CentralProblem {
                 obstacle_terms(
                     quad,
                     input.obstacles,
+                    input.distance_cost_off,
                     &tp.distance,
                     tp.weight_distance,
                     &tp.clearance,
@@ -606,6 +616,7 @@ impl Subproblem for CentralProblem {
                 self.tug_params.clearance.rows(PER_STEP, TUG[0]),
                 self.tug_params.clearance.rows(PER_STEP, TUG[1]),
             ],
+            motion: self.ship_params.motion.rows(PER_STEP, SHIP),
         }
     }
 

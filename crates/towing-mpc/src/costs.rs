@@ -1,7 +1,8 @@
 //! The cost terms the subproblems share, each written once: the ship's stage
 //! terms of eq. (13) (with the regularisers, the terminal term and the one-sided
 //! heading term of `docs/assumptions.md`), the obstacle terms (the distance cost
-//! `phi` of eq. (13)-(14) and the hard clearance rows of the design document),
+//! `phi` of eq. (13)-(14) and the hard clearance rows of the design document), the
+//! ship's motion limits (drift, sternway, speed),
 //! the tugs' move suppression of the centralized problem, and the heading
 //! difference. A term feeds the [`QuadModel`] with its value and, where the
 //! subproblem linearises, its rows `dr/du` over the step's increments.
@@ -88,15 +89,121 @@ impl ClearanceParams {
     }
 }
 
+/// Soft limits on the ship's predicted motion, the seamanship of
+/// `docs/colregs.md` ("Seamanship") made constraints of the MPC: no drift angle
+/// above `max_drift` under way, no sternway beyond `max_sternway`, no surge above
+/// `max_speed`. Four linear rows per sample in the predicted surge `u` and sway `v`,
+/// each with an exact L1 penalty on its slack (the [`SlotRows`] block of the engine;
+/// Nocedal and Wright 2006, section 17.2):
+///
+/// ```text
+/// tan(max_drift) u - v >= -sway_allowance     (drift to starboard)
+/// tan(max_drift) u + v >= -sway_allowance     (drift to port)
+/// u >= -max_sternway
+/// -u >= -max_speed
+/// ```
+///
+/// `|v| <= tan(max_drift) u + sway_allowance` is the drift angle `atan2(v, u)`
+/// bounded by `max_drift` above the sway allowance; at rest it leaves the small
+/// sideways motion a final approach needs. The rows are linear in the state, so the
+/// linearisation is exact in the state and only the model's is approximate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionLimits {
+    /// Largest drift angle (rad) under way.
+    pub max_drift: f64,
+    /// Sway speed (m/s) allowed whatever the surge.
+    pub sway_allowance: f64,
+    /// Largest surge astern (m/s, >= 0).
+    pub max_sternway: f64,
+    /// Largest surge ahead (m/s).
+    pub max_speed: f64,
+    /// `W`: L1 penalty on a slack (per m/s); 0 turns the limits off.
+    pub penalty: f64,
+    /// Upper bound of a slack (m/s).
+    pub max_slack: f64,
+}
+
+impl Default for MotionLimits {
+    /// `max_drift = 22 deg`, `sway_allowance = 0.005 m/s`, `max_sternway = 0.01 m/s`,
+    /// `max_speed = 0.11 m/s`, `W = 1e4`, `s_max = 1 m/s`: inside the seamanship
+    /// bounds (30 deg at 0.05 m/s and more, 0.03 m/s astern, 1.3 times a cruise of
+    /// about 0.09 m/s) by the margin a 3 s horizon's prediction error needs
+    /// (`docs/assumptions.md`).
+    fn default() -> Self {
+        MotionLimits {
+            max_drift: 22f64.to_radians(),
+            sway_allowance: 0.005,
+            max_sternway: 0.01,
+            max_speed: 0.11,
+            penalty: 1e4,
+            max_slack: 1.0,
+        }
+    }
+}
+
+impl MotionLimits {
+    /// Rows per sample.
+    pub const SLOTS: usize = 4;
+
+    /// The block of rows over `per_step` increments per sample, about the ship
+    /// (`vessels`, [`crate::engine::Channel::moves`]).
+    #[must_use]
+    pub fn rows(&self, per_step: usize, vessels: u8) -> SlotRows {
+        SlotRows::new(
+            Self::SLOTS,
+            (HORIZON, per_step),
+            vessels,
+            self.penalty,
+            self.max_slack,
+        )
+    }
+
+    /// The rows' values `g(x)`, bounds `b` (`g >= b`) and `dg/d(u, v)`.
+    fn limits(&self) -> [(f64, [f64; 2]); 4] {
+        let t = self.max_drift.tan();
+        [
+            (-self.sway_allowance, [t, -1.0]),
+            (-self.sway_allowance, [t, 1.0]),
+            (-self.max_sternway, [1.0, 0.0]),
+            (-self.max_speed, [-1.0, 0.0]),
+        ]
+    }
+
+    /// The penalty of the predicted state `x` (after sample `h`) and, with `rows`,
+    /// its linearised rows (`dx[c]` = `d x_c / du` over the QP's increments).
+    pub(crate) fn terms<const N: usize>(
+        &self,
+        quad: &mut QuadModel,
+        mut rows: Option<&mut SlotRows>,
+        h: usize,
+        x: &ShipState,
+        dx: &[[f64; N]; 6],
+    ) {
+        if self.penalty <= 0.0 {
+            return;
+        }
+        for (j, (bound, g)) in self.limits().into_iter().enumerate() {
+            let value = g[0] * x[3] + g[1] * x[4];
+            quad.value += self.penalty * (bound - value).max(0.0);
+            if let Some(r) = rows.as_deref_mut() {
+                let row: [f64; N] = std::array::from_fn(|k| g[0] * dx[3][k] + g[1] * dx[4][k]);
+                r.record(h, j, value, bound, &row);
+            }
+        }
+    }
+}
+
 /// The obstacle terms of one predicted position `pos` (the state after sample
 /// `h`; moving obstacles as predicted then, [`Obstacle::after`]) with
 /// `d(x, y)/du = (row_x, row_y)`: the distance cost `w phi(d)` of every obstacle
-/// and, for the first `params.max_obstacles`, the clearance penalty and (with
-/// `clearance`) the linearised row.
+/// but those of `distance_cost_off` (bit `j` for `obstacles[j]`) and, for the first
+/// `params.max_obstacles`, the clearance penalty and (with `clearance`) the
+/// linearised row.
 #[allow(clippy::too_many_arguments)] // the pieces of one term; three call sites
 pub(crate) fn obstacle_terms<const N: usize>(
     quad: &mut QuadModel,
     obstacles: &[Obstacle],
+    distance_cost_off: u64,
     distance: &DistanceCost,
     w: f64,
     params: &ClearanceParams,
@@ -108,12 +215,14 @@ pub(crate) fn obstacle_terms<const N: usize>(
 ) {
     for (j, obstacle) in obstacles.iter().enumerate() {
         let (d, grad) = obstacle.after(h + 1).distance(pos);
-        let (phi, slope, curvature) = distance.eval(d);
         let mut row = [0.0; N];
         for (r, (a, b)) in row.iter_mut().zip(row_x.iter().zip(row_y)) {
             *r = grad[0] * a + grad[1] * b;
         }
-        quad.curved(phi, slope, curvature, w, &row);
+        if j >= 64 || (distance_cost_off >> j) & 1 == 0 {
+            let (phi, slope, curvature) = distance.eval(d);
+            quad.curved(phi, slope, curvature, w, &row);
+        }
         if j < params.max_obstacles {
             quad.value += params.penalty_at(d);
             if let Some(c) = clearance.as_deref_mut() {

@@ -30,7 +30,7 @@
 
 use nalgebra::Matrix6x4;
 
-use crate::costs::{angle_difference, obstacle_terms, ship_stage_terms, ClearanceParams};
+use crate::costs::{angle_difference, obstacle_terms, ship_stage_terms, ClearanceParams, MotionLimits};
 use crate::engine::{
     Block, BlockMut, Channel, InputSpace, QuadModel, RowSet, Scp, ScpSettings, SlotRows,
     Subproblem, ALL_VESSELS,
@@ -48,7 +48,9 @@ const N: usize = 4 * HORIZON;
 pub struct ShipMpcParams {
     /// `w_S1` on the position error `x, y` (1/m^2), eq. (13) (Table 3: 1).
     pub weight_position: f64,
-    /// `w_S1` on the heading error (1/rad^2), eq. (13) (Table 3: 1).
+    /// `w_S1` on the heading error (1/rad^2), eq. (13) (Table 3: 1; here 10 by
+    /// default, so that the ship turns to her reference course instead of being
+    /// dragged sideways towards the tracked point: `docs/assumptions.md`).
     pub weight_heading: f64,
     /// `w_S2` on the surge speed `u` (s^2/m^2), eq. (13) (Table 3: 75).
     pub weight_surge: f64,
@@ -102,13 +104,16 @@ pub struct ShipMpcParams {
     /// ([`ShipStepData::heading_floor`]). Not in the paper: see
     /// [`crate::costs`].
     pub weight_port_turn: f64,
+    /// Soft limits on the predicted drift angle, sternway and speed
+    /// ([`MotionLimits`]). Not in the paper (`docs/assumptions.md`).
+    pub motion: MotionLimits,
 }
 
 impl Default for ShipMpcParams {
     fn default() -> Self {
         ShipMpcParams {
             weight_position: 1.0,
-            weight_heading: 1.0,
+            weight_heading: 10.0,
             weight_surge: 75.0,
             weight_sway: 75.0,
             weight_yaw_rate: 75.0,
@@ -129,6 +134,7 @@ impl Default for ShipMpcParams {
             distance: DistanceCost::default(),
             clearance: ClearanceParams::with_min_distance(0.75),
             weight_port_turn: 100.0,
+            motion: MotionLimits::default(),
         }
     }
 }
@@ -225,6 +231,8 @@ pub struct ShipStepData<'a> {
     pub rho: f64,
     /// Static obstacles.
     pub obstacles: &'a [Obstacle],
+    /// Obstacles left out of the distance cost ([`crate::SampleInput::distance_cost_off`]).
+    pub distance_cost_off: u64,
     /// The lowest heading the ship may take over the horizon (rad), from
     /// COLREGS: no turn to port while the tow gives way or stands on.
     pub heading_floor: Option<f64>,
@@ -248,18 +256,23 @@ pub struct ShipLinearised {
     states: [ShipState; HORIZON],
 }
 
-/// The coordination problem's soft rows: the clearance rows.
+/// The coordination problem's soft rows: the clearance rows and the motion limits.
 #[derive(Debug, Clone)]
 pub struct ShipRows {
     clearance: SlotRows,
+    motion: SlotRows,
 }
 
 impl RowSet for ShipRows {
     fn blocks(&self) -> impl Iterator<Item = Block<'_>> {
-        std::iter::once(Block::Slots(&self.clearance))
+        [Block::Slots(&self.clearance), Block::Slots(&self.motion)].into_iter()
     }
     fn blocks_mut(&mut self) -> impl Iterator<Item = BlockMut<'_>> {
-        std::iter::once(BlockMut::Slots(&mut self.clearance))
+        [
+            BlockMut::Slots(&mut self.clearance),
+            BlockMut::Slots(&mut self.motion),
+        ]
+        .into_iter()
     }
 }
 
@@ -318,6 +331,7 @@ impl Subproblem for ShipProblem {
     fn rows(&self) -> ShipRows {
         ShipRows {
             clearance: self.params.clearance.rows(4, ALL_VESSELS),
+            motion: self.params.motion.rows(4, ALL_VESSELS),
         }
     }
 
@@ -370,8 +384,8 @@ impl Subproblem for ShipProblem {
         model: Option<(&ShipLinearised, &mut ShipRows)>,
         data: &ShipStepData<'_>,
     ) -> f64 {
-        let (sens, clearance) = match model {
-            Some((lin, rows)) => (Some(&lin.sens), Some(&mut rows.clearance)),
+        let (sens, rows) = match model {
+            Some((lin, rows)) => (Some(&lin.sens), Some(rows)),
             None => (None, None),
         };
         accumulate(
@@ -381,7 +395,7 @@ impl Subproblem for ShipProblem {
             traj,
             &ship_inputs(plan),
             sens,
-            clearance,
+            rows,
             data,
         );
         quad.value
@@ -418,7 +432,7 @@ impl Scp<ShipProblem> {
 }
 
 /// The cost terms of `states` (after samples 0..H) reached with `plan`; with
-/// `sens` the model rows too (and the clearance rows recorded).
+/// `sens` the model rows too (and the clearance and motion rows recorded).
 #[allow(clippy::too_many_arguments)] // one call site per use; a struct would only rename them
 fn accumulate(
     quad: &mut QuadModel,
@@ -427,7 +441,7 @@ fn accumulate(
     states: &[ShipState; HORIZON],
     plan: &[ShipInput; HORIZON],
     sens: Option<&[[Matrix6x4<f64>; HORIZON]; HORIZON]>,
-    mut clearance: Option<&mut SlotRows>,
+    mut soft: Option<&mut ShipRows>,
     data: &ShipStepData<'_>,
 ) {
     let w3 = params.weight_distance;
@@ -456,6 +470,8 @@ fn accumulate(
             h + 1 == HORIZON,
             data.heading_floor,
         );
+        let motion = soft.as_deref_mut().map(|r| &mut r.motion);
+        params.motion.terms(quad, motion, h, x, &rows);
         for i in 0..2 {
             let (f, jac) = formation.tug_reference_linearised(eta, plan[h][2 + i], i);
             let g = data.tug_poses[i][h];
@@ -477,10 +493,11 @@ fn accumulate(
         obstacle_terms(
             quad,
             data.obstacles,
+            data.distance_cost_off,
             &params.distance,
             w3,
             &params.clearance,
-            clearance.as_deref_mut(),
+            soft.as_deref_mut().map(|r| &mut r.clearance),
             h,
             [x[0], x[1]],
             &rows[0],
@@ -528,6 +545,7 @@ mod tests {
             lambda: [[[0.0; 3]; HORIZON]; 2],
             rho,
             obstacles: &[],
+            distance_cost_off: 0,
             heading_floor: None,
         }
     }
@@ -603,14 +621,50 @@ mod tests {
         assert!(states[HORIZON - 1][0] > 0.0 && states[HORIZON - 1][3] > 0.0);
     }
 
+    /// A reference astern, and one abeam: without the motion limits the plan backs
+    /// the ship and drags her sideways beyond them; with them the predicted sternway
+    /// and drift stay inside (to the slack the exact penalty leaves, below 1 mm/s).
+    #[test]
+    fn motion_limits_keep_the_plan_from_sternway_and_sideways_motion() {
+        let worst = |params: ShipMpcParams, reference: [f64; 3]| {
+            let mut mpc = ship_mpc_with(params);
+            let data = data_at_rest(&mpc, reference, 0.0);
+            for _ in 0..40 {
+                assert!(mpc.step(&data).qp.is_usable());
+            }
+            let m = params.motion;
+            let t = m.max_drift.tan();
+            mpc.predicted().iter().fold(0.0f64, |w, x| {
+                let drift = x[4].abs() - (t * x[3] + m.sway_allowance);
+                let astern = -x[3] - m.max_sternway;
+                w.max(drift).max(astern)
+            })
+        };
+        let on = ShipMpcParams::default();
+        let off = ShipMpcParams {
+            motion: MotionLimits {
+                penalty: 0.0,
+                ..on.motion
+            },
+            ..on
+        };
+        for reference in [[-2.0, 0.0, 0.0], [0.0, 2.0, 0.0]] {
+            let (with, without) = (worst(on, reference), worst(off, reference));
+            assert!(with < 1e-3, "{reference:?}: {with} m/s beyond the limits");
+            assert!(without > 5e-3, "{reference:?}: {without} m/s without them");
+        }
+    }
+
     /// A reference to port turns the ship to port; a heading floor at the
     /// current heading keeps its predicted headings (nearly) to starboard of it,
     /// and a floor below every predicted heading changes nothing.
     #[test]
     fn a_heading_floor_stops_a_turn_to_port() {
         let run = |floor: Option<f64>| {
+            // Table 3's heading weight: the floor's weight 1e4 against a pull of 1.
             let mut mpc = ship_mpc_with(ShipMpcParams {
                 weight_port_turn: 1e4,
+                weight_heading: 1.0,
                 ..ShipMpcParams::default()
             });
             let mut data = data_at_rest(&mpc, [1.0, -1.0, -0.5], 0.0);

@@ -128,6 +128,8 @@ pub struct TugStepData<'a> {
     pub rho: f64,
     /// Static obstacles.
     pub obstacles: &'a [Obstacle],
+    /// Obstacles left out of the distance cost ([`crate::SampleInput::distance_cost_off`]).
+    pub distance_cost_off: u64,
 }
 
 /// A tug's local problem (module docs).
@@ -330,6 +332,7 @@ fn accumulate(
         obstacle_terms(
             quad,
             data.obstacles,
+            data.distance_cost_off,
             &params.distance,
             w3,
             &params.clearance,
@@ -370,6 +373,7 @@ mod tests {
             lambda: [[0.0; 3]; HORIZON],
             rho: 1.0,
             obstacles,
+            distance_cost_off: 0,
         }
     }
 

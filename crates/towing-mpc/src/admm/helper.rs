@@ -53,6 +53,7 @@ struct Job {
     lambda: [[f64; 3]; HORIZON],
     rho: f64,
     obstacles: Vec<Obstacle>,
+    distance_cost_off: u64,
 }
 
 impl Job {
@@ -64,6 +65,7 @@ impl Job {
         self.rho = d.rho;
         self.obstacles.clear();
         self.obstacles.extend_from_slice(d.obstacles);
+        self.distance_cost_off = d.distance_cost_off;
     }
 
     fn data(&self) -> TugStepData<'_> {
@@ -74,6 +76,7 @@ impl Job {
             lambda: self.lambda,
             rho: self.rho,
             obstacles: &self.obstacles,
+            distance_cost_off: self.distance_cost_off,
         }
     }
 }

@@ -6,10 +6,18 @@ use super::*;
 
 /// The coordination problem with the cost of eq. (13) as printed (no terminal
 /// term; the closed loop's default adds one, `docs/assumptions.md`).
+/// The cost as the paper prints it (eq. (13), Table 3): no terminal term, the heading
+/// weight of Table 3, no motion limits.
 pub(crate) fn printed_cost() -> ShipMpcParams {
+    let defaults = ShipMpcParams::default();
     ShipMpcParams {
         terminal: None,
-        ..ShipMpcParams::default()
+        weight_heading: 1.0,
+        motion: crate::MotionLimits {
+            penalty: 0.0,
+            ..defaults.motion
+        },
+        ..defaults
     }
 }
 
@@ -47,6 +55,7 @@ fn paper_input(obstacles: &[Obstacle]) -> SampleInput<'_> {
         previous: AppliedCommand::default(),
         reference: reference_ahead(&ship, 2.0),
         obstacles,
+        distance_cost_off: 0,
         heading_floor: None,
     }
 }
@@ -134,6 +143,7 @@ fn plant_like_next<'a>(a: &Admm, input: &SampleInput<'a>, r: &AdmmReport) -> Sam
         },
         reference: reference_ahead(&ship, 2.0),
         obstacles: input.obstacles,
+        distance_cost_off: input.distance_cost_off,
         heading_floor: None,
     }
 }

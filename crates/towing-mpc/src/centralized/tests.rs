@@ -47,6 +47,7 @@ fn instance(ahead: f64, lateral: f64, turn: f64, d: f64) -> SampleInput<'static>
         },
         reference: [target; HORIZON],
         obstacles: &[],
+        distance_cost_off: 0,
         heading_floor: None,
     }
 }
