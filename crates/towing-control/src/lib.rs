@@ -35,8 +35,8 @@ pub use config::{
     TrackingParams, Tuning, WaterwaySettings,
 };
 pub use controller::{
-    centralized_mpc, mpc_params, Command, Controller, Fallback, Measurement, Prediction,
-    SampleReport, Step, StepError, SAMPLE_TOLERANCE,
+    centralized_mpc, mpc_params, Command, Controller, Fallback, Measurement, Overlap, Prediction,
+    Rest, SampleReport, Step, StepError, SAMPLE_TOLERANCE,
 };
 pub use error::{ConfigError, MeasurementError};
 pub use mpc_input::MpcInput;

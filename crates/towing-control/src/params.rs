@@ -18,6 +18,7 @@
 //! | `waterway` | the waterway's half width |
 //! | `tracking` | how the MPC tracks the reference (lookahead, line of sight, heading floor) |
 //! | `inner_loop` | the tugs' inner stabilising loop |
+//! | `fmi` | how the FMU reports to its master (fmi2DoStep statuses) |
 //!
 //! `architecture` and `avoidance_scheme` keep their ungrouped names (the masters
 //! and the interface contract use them). Every Real declares its unit, one unit
@@ -718,6 +719,15 @@ pub static PARAMETERS: &[Parameter] = &[
             max: Limit::None,
             get: |t| t.inner.gain[2],
             set: |t, v| t.inner.gain[2] = v,
+        },
+    },
+    Parameter {
+        name: "fmi.warning_on_fallback",
+        old_name: None,
+        description: "true: a control sample that falls back (its plan replaced by the previous plan, shifted) makes fmi2DoStep return fmi2Warning (FMI 2.0 section 4.2.2), which stops masters that end on any status above fmi2OK (fmusim, OMSimulator); false: fmi2OK. Either way the fallback is logged as a warning (category logStatusWarning, and the MCAP log's /controller/log) and counted in controller.fallbacks",
+        kind: Kind::Boolean {
+            get: |t| t.warning_on_fallback,
+            set: |t, v| t.warning_on_fallback = v,
         },
     },
 ];
