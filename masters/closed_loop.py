@@ -68,7 +68,8 @@ Writes:
 
 fmpy's FMU2Slave raises FMICallException for every status above fmi2Warning and returns
 warnings silently; this master calls fmi2DoStep itself to see the status, counts warnings
-(an MPC fallback is reported as fmi2Warning) and stops on anything worse, printing the
+(an MPC fallback is fmi2OK, counted in the controller's `controller.fallbacks`; fmi2Warning
+only with --param fmi.warning_on_fallback=true) and stops on anything worse, printing the
 messages both FMUs logged. Exit status: 0 on success, 1 on an FMU error, 2 on a usage or
 connection error.
 """

@@ -223,13 +223,16 @@ fn the_mcap_magic_followed_by_random_bytes_is_a_clean_error() {
 
 #[test]
 fn a_tow_at_1e308_m_gives_a_clipped_map_not_a_hang() {
-    // The plant accepts a towline of desired_length = 1.7976931348623157e308: the tugs in
-    // formation sit about that far from the ship, one aft and one ahead (x of 1.8e308 m
-    // of both signs: an axis that spans more than f64::MAX).
+    // The plant accepted a towline of desired_length = 1.7976931348623157e308 (the tugs
+    // in formation about that far from the ship, one aft and one ahead: x of 1.8e308 m of
+    // both signs, an axis that spans more than f64::MAX); it refuses lengths beyond 1e8 m
+    // now, but a runaway tug still logs positions beyond 1e154 m before its step is
+    // discarded. Here the towlines stretch to about 1.7e308 m (an elongation amplitude of
+    // f64::MAX on lines of 1 m).
     let dir = tempfile::tempdir().expect("tempdir");
     let mut run = common::straight(20.0, 0.1, 200);
-    run.towline_length = [f64::MAX, f64::MAX];
-    run.elongation = [0.0, 0.0];
+    run.towline_length = [1.0, 1.0];
+    run.elongation = [f64::MAX, f64::MAX];
     run.scene = true;
     let (plant, controller) = common::write_logs(&run, dir.path());
     let out = dir.path().join("report");

@@ -38,7 +38,8 @@ use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome, V
 use serde::{Deserialize, Serialize};
 use towing_control::params::{Value, PARAMETERS};
 use towing_control::{
-    ConfigError, Controller, ControllerConfig, ControllerState, Measurement, Tuning,
+    ConfigError, Controller, ControllerConfig, ControllerState, Measurement, SampleReport,
+    Tuning,
 };
 use towing_interface::codec::{
     obstacle_kind_code, obstacle_kind_from_code, ContractVariable, ObstacleField, TowlineField,
@@ -247,6 +248,23 @@ impl ControllerFmu {
     }
 }
 
+/// What a sample tells the master: a fallback, or the first sample of a run at rest (the
+/// inputs describe no tow); `None` for a sample that solved, or that rests on.
+fn sample_warning(report: &SampleReport, t: f64) -> Option<String> {
+    if let Some(reason) = report.fallback {
+        return Some(format!(
+            "fallback: {reason} (sample at t = {t} s; the previous plan, shifted, is applied)"
+        ));
+    }
+    report.rest.filter(|r| r.first).map(|r| {
+        format!(
+            "at rest: {} (sample at t = {t} s; the tensions go to the pretension and the angles \
+             to zero, no thrust, until the inputs describe a tow)",
+            r.overlap
+        )
+    })
+}
+
 impl Fmi2Model for ControllerFmu {
     fn description() -> &'static fmi2_slave::description::ModelDescription {
         &vars::DESCRIPTION
@@ -419,7 +437,11 @@ impl Fmi2Model for ControllerFmu {
         }
     }
 
-    fn do_step(&mut self, _log: &Logger, step: &StepContext) -> StepOutcome {
+    /// A fallback is logged as a warning (category `logStatusWarning`) and written to the
+    /// MCAP log; it is `fmi2Warning` only with `fmi.warning_on_fallback` (masters such as
+    /// fmusim and OMSimulator stop on any status above `fmi2OK`). The first sample at rest
+    /// ([`towing_control::Rest`]) is logged the same way, and is `fmi2OK`.
+    fn do_step(&mut self, log: &Logger, step: &StepContext) -> StepOutcome {
         let controller = match &mut self.core {
             Core::Live(c) => c,
             Core::None => {
@@ -440,21 +462,20 @@ impl Fmi2Model for ControllerFmu {
         self.outputs.command = step_result.command;
         let mut outcome = StepOutcome::Ok;
         let mut sampled = None;
+        let mut warning = None;
         if let Some(report) = step_result.sample {
             self.outputs.record(&report);
-            if let Some(reason) = report.fallback {
-                outcome = StepOutcome::Warning(format!(
-                    "fallback: {reason} (sample at t = {} s; the previous plan, shifted, is applied)",
-                    step.current_time
-                ));
+            warning = sample_warning(&report, step.current_time);
+            if let Some(message) = &warning {
+                if report.fallback.is_some() && self.params.warning_on_fallback {
+                    outcome = StepOutcome::Warning(message.clone());
+                } else {
+                    log.warning(&format!("fmi2DoStep: {message}"));
+                }
             }
             sampled = Some(report);
         }
         self.time = step.current_time + step.step_size;
-        let warning = match &outcome {
-            StepOutcome::Warning(m) => Some(m.clone()),
-            _ => None,
-        };
         // A logging failure is a warning (docs/interface.md, "MCAP log").
         let failed = self.session.log_step(|| {
             let report = sampled?;

@@ -363,14 +363,14 @@ fn solver() -> Vec<Diagnostic> {
             format!("admm.primal_residual{n}"),
             primal_residual(tug),
             "",
-            format!("last primal residual |g_{n} - f_{n}|_2 of tug {n}'s consensus (Algorithm 1, eq. (29)), in the units of the pose [m, m, rad] stacked over the horizon"),
+            format!("last primal residual |g_{n} - f_{n}|_2 of tug {n}'s consensus (Algorithm 1, eq. (29)), in the units of the pose [m, m, rad] stacked over the horizon; 0 in a sample at rest, 1.7976931348623157e308 (the largest finite value) when the iterate overflowed"),
             move |o| o.r_pri[i],
         ));
         v.push(Diagnostic::real(
             format!("admm.dual_residual{n}"),
             dual_residual(tug),
             "",
-            format!("last dual residual |f_{n}^s - f_{n}^(s-1)|_2 of tug {n} (eq. (28) as printed, without rho)"),
+            format!("last dual residual |f_{n}^s - f_{n}^(s-1)|_2 of tug {n} (eq. (28) as printed, without rho); 0 in a sample at rest, 1.7976931348623157e308 (the largest finite value) when the iterate overflowed"),
             move |o| o.r_dual[i],
         ));
     }
@@ -391,7 +391,7 @@ fn solver() -> Vec<Diagnostic> {
         "controller.fallbacks".into(),
         FALLBACKS,
         COUNT,
-        "samples since instantiation whose plan was replaced by the previous plan, shifted (each one is reported with fmi2Warning \"fallback: <reason>\")".into(),
+        "samples since instantiation whose plan was replaced by the previous plan, shifted (each one is logged as a warning \"fallback: <reason>\", category logStatusWarning; fmi2DoStep returns fmi2Warning for it only with fmi.warning_on_fallback)".into(),
         |o| o.fallbacks,
     ));
     v.push(Diagnostic::integer(

@@ -493,25 +493,149 @@ fn a_corrupt_or_forged_controller_state_is_refused() {
 }
 
 /// A sample whose QPs fail (a circle of 100 m radius over the tow makes every
-/// clearance row infeasible) returns fmi2Warning with a "fallback:" log line, counts
-/// the fallback, and keeps the commands finite and within their bounds.
+/// clearance row infeasible) falls back: by default fmi2OK, the fallback logged as a
+/// warning (category logStatusWarning, "fallback: <reason>") and counted; with
+/// `fmi.warning_on_fallback` fmi2Warning. The commands stay finite and within their bounds.
 #[test]
-fn a_failed_solve_is_a_warning_with_a_counted_fallback() {
-    let states = paper_states();
-    let ship = states[0];
-    let fmu = initialized("fallback");
-    let mut t = steps(&fmu, 0.0, 1.0, 2);
-    set_obstacle(&fmu, 7, [ship[0], ship[1], 0.0, 0.0, 200.0, 200.0], 1);
-    for k in 1..=3 {
-        assert_eq!(fmu.step(t, 1.0), Fmi2Status::Warning, "{}", fmu.log_text());
-        t += 1.0;
-        assert!(fmu.last_text().contains("fallback:"), "{}", fmu.log_text());
-        assert_eq!(fmu.get_integer(vars::FALLBACKS), k);
-        let c = commands(&fmu);
-        assert!(c.iter().all(|v| v.is_finite()), "{c:?}");
-        assert!(
-            c[6] >= 0.0 && c[6] <= 3.0 && c[7] >= 0.0 && c[7] <= 3.0,
-            "{c:?}"
-        );
+fn a_failed_solve_is_a_counted_fallback_logged_as_a_warning() {
+    for warning_on_fallback in [false, true] {
+        let states = paper_states();
+        let ship = states[0];
+        let fmu = controller("fallback");
+        set_states(&fmu, &states);
+        if warning_on_fallback {
+            assert_eq!(
+                fmu.set_boolean(var("fmi.warning_on_fallback"), true),
+                Fmi2Status::Ok
+            );
+        }
+        fmu.init(0.0, None);
+        let expected = if warning_on_fallback {
+            Fmi2Status::Warning
+        } else {
+            Fmi2Status::Ok
+        };
+        let mut t = steps(&fmu, 0.0, 1.0, 2);
+        set_obstacle(&fmu, 7, [ship[0], ship[1], 0.0, 0.0, 200.0, 200.0], 1);
+        for k in 1..=3 {
+            fmu.clear();
+            assert_eq!(fmu.step(t, 1.0), expected, "{}", fmu.log_text());
+            let m = fmu.messages().pop().unwrap();
+            assert_eq!(m.status, Fmi2Status::Warning as i32, "{m:?}");
+            assert_eq!(m.category, "logStatusWarning");
+            assert!(
+                m.text.starts_with("fmi2DoStep: fallback: the "),
+                "{}",
+                m.text
+            );
+            assert!(
+                m.text.contains(&format!("(sample at t = {t} s;")),
+                "{}",
+                m.text
+            );
+            t += 1.0;
+            assert_eq!(fmu.get_integer(vars::FALLBACKS), k);
+            let c = commands(&fmu);
+            assert!(c.iter().all(|v| v.is_finite()), "{c:?}");
+            assert!(
+                c[6] >= 0.0 && c[6] <= 3.0 && c[7] >= 0.0 && c[7] <= 3.0,
+                "{c:?}"
+            );
+        }
+    }
+}
+
+/// `fmi2DoStep(t, h)` is fmi2OK and every one of `outputs` is finite after it.
+fn step_ok_and_finite(fmu: &fmi2_slave::testing::Fmu, t: f64, h: f64, outputs: &[u32], what: &str) {
+    assert_eq!(fmu.step(t, h), Fmi2Status::Ok, "{what}: {}", fmu.log_text());
+    let (s, values) = fmu.try_get_reals(outputs);
+    assert_eq!(s, Fmi2Status::Ok);
+    for (vr, v) in outputs.iter().zip(&values) {
+        assert!(v.is_finite(), "{what}: vr {vr} = {v}");
+    }
+}
+
+/// Run alone, as fmuCheck, fmusim and `fmpy.simulate_fmu` do (inputs never set: every
+/// vessel at (0, 0)), the controller rests: 60 s of fmi2OK, no fallback, every output
+/// finite, the tensions at the pretension and no thrust, and one log line saying why.
+#[test]
+fn run_alone_with_inputs_never_set_the_controller_rests_without_fallbacks() {
+    let fmu = controller("alone");
+    fmu.init(0.0, None);
+    let outputs = testing::real_outputs(&DESCRIPTION);
+    let mut t = 0.0;
+    for k in 0..600 {
+        step_ok_and_finite(&fmu, t, 0.1, &outputs, &format!("step {k}"));
+        t += 0.1;
+    }
+    assert_eq!(fmu.get_integer(vars::SAMPLES), 60);
+    assert_eq!(fmu.get_integer(vars::FALLBACKS), 0, "{}", fmu.log_text());
+    let c = commands(&fmu);
+    let pretension = ShipMpcParams::default().min_tension;
+    assert_eq!(&c[..6], &[0.0; 6], "no thrust: {c:?}");
+    assert_eq!(&c[6..], &[pretension; 2], "the pretension: {c:?}");
+    let lines: Vec<_> = fmu
+        .messages()
+        .into_iter()
+        .filter(|m| m.status != Fmi2Status::Ok as i32)
+        .collect();
+    assert_eq!(lines.len(), 1, "{lines:?}");
+    assert_eq!(lines[0].category, "logStatusWarning");
+    assert!(
+        lines[0].text.starts_with(
+            "fmi2DoStep: at rest: the measured tug1 is 0 m from the ship, less than half a beam"
+        ),
+        "{}",
+        lines[0].text
+    );
+    assert!(
+        lines[0].text.contains("sample at t = 0 s"),
+        "{}",
+        lines[0].text
+    );
+    // Once the inputs describe the tow, the controller solves again.
+    set_states(&fmu, &paper_states());
+    assert_eq!(fmu.step(t, 1.0), Fmi2Status::Ok, "{}", fmu.log_text());
+    assert!(fmu.get_integer(vars::ADMM_ITERATIONS) >= 1);
+    assert_eq!(fmu.get_integer(vars::FALLBACKS), 0);
+}
+
+/// Speeds far beyond the model's range (10 to 1000 m/s) make the MPC's iterates
+/// overflow: the sample falls back, and every output stays finite (the residuals of the
+/// overflowed iterate at f64::MAX, the predictions the measured states held), with the
+/// commands within their bounds and fmi2OK.
+#[test]
+fn absurd_speeds_give_finite_outputs_never_nan() {
+    let outputs = testing::real_outputs(&DESCRIPTION);
+    for speed in [10.0, 100.0, 1000.0] {
+        let fmu = controller("fast");
+        let mut states = paper_states();
+        for s in &mut states {
+            s[3] = speed;
+            s[4] = -0.5 * speed;
+        }
+        set_states(&fmu, &states);
+        fmu.init(0.0, None);
+        let mut t = 0.0;
+        for k in 0..5 {
+            step_ok_and_finite(&fmu, t, 1.0, &outputs, &format!("{speed} m/s, sample {k}"));
+            t += 1.0;
+            assert_commands_within_bounds(&fmu);
+        }
+    }
+}
+
+/// A master that sums `t += 0.1` and clips its last step at the stop time (OMSimulator)
+/// ends with a step of a few 1e-12 s: every doStep is fmi2OK, to every stop time the issue
+/// names.
+#[test]
+fn a_summing_master_reaches_every_stop_time_with_fmi2ok() {
+    for stop in fmi2_slave::testing::SUMMING_MASTER_STOP_TIMES {
+        let fmu = controller("summing");
+        set_states(&fmu, &paper_states());
+        fmu.init(0.0, Some(stop));
+        fmi2_slave::testing::assert_summing_master_reaches(&fmu, stop, 0.1);
+        assert_eq!(i64::from(fmu.get_integer(vars::SAMPLES)), stop as i64);
+        assert_eq!(fmu.get_integer(vars::FALLBACKS), 0);
     }
 }

@@ -27,15 +27,7 @@ fn pull(fmu: &Fmu) {
 
 /// Every Real output's value reference.
 fn real_outputs() -> Vec<u32> {
-    DESCRIPTION
-        .variables
-        .iter()
-        .filter(|v| {
-            v.causality == fmi2_slave::Causality::Output
-                && v.value_type() == fmi2_slave::ValueType::Real
-        })
-        .map(|v| v.value_reference)
-        .collect()
+    testing::real_outputs(&DESCRIPTION)
 }
 
 fn run(fmu: &Fmu, t0: f64, steps: usize) -> (Vec<Vec<f64>>, f64) {
@@ -305,6 +297,15 @@ fn every_kind_of_bad_scenario_is_refused_naming_file_field_and_reason() {
             "> 0",
         ),
         (
+            "length beyond any physical size",
+            edited_paper(
+                "[towline2]\ndesired_length = 1.0\n",
+                "[towline2]\ndesired_length = 1.7976931348623157e308\n",
+            ),
+            "towline2.desired_length",
+            "must be at most 1e8 m in magnitude (MAX_DISTANCE",
+        ),
+        (
             "too many obstacles",
             edited_paper(
                 "\n# Physics of the plant",
@@ -368,6 +369,61 @@ fn a_step_that_would_go_non_finite_is_discarded_at_the_last_good_time() {
     assert_eq!(s, Fmi2Status::Ok);
     assert!(values.iter().all(|v| v.is_finite()), "outputs stay finite");
     assert_eq!(fmu.terminate(), Fmi2Status::Ok);
+}
+
+/// A tug whose damping feeds energy in (`x_u = 2000`, linear damping hull) under full surge
+/// thrust runs away: from about 3.4 s its position is beyond 1e154 m, where the towline's
+/// length (the root of a sum of squares) overflows while every state is still finite (until
+/// about 6.4 s). Those steps returned fmi2OK with `towline1.length = inf`; the first of them
+/// is now fmi2Discard naming the towline, at the last good time, every output still finite.
+#[test]
+fn a_step_with_a_non_finite_output_is_discarded_not_ok() {
+    let runaway = edited_paper(
+        "\n# Physics of the plant",
+        "\n[vessels.tug1.damping]\nx_u = 2000.0\n\n# Physics of the plant",
+    )
+    .replace(
+        "hull_model = \"nonlinear_damping\"",
+        "hull_model = \"linear_damping\"",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("runaway.toml");
+    std::fs::write(&path, runaway).unwrap();
+    let fmu = plant("runaway");
+    assert_eq!(
+        fmu.set_string(vars::SCENARIO, path.to_str().unwrap()),
+        Fmi2Status::Ok
+    );
+    fmu.init(0.0, None);
+    assert_eq!(fmu.set_real(vars::tug_force(0, 0), 10.0), Fmi2Status::Ok);
+    let outputs = real_outputs();
+    let mut t = 0.0;
+    let mut status = Fmi2Status::Ok;
+    let mut ok_steps = 0;
+    while status == Fmi2Status::Ok && ok_steps < 1000 {
+        status = fmu.step(t, 0.1);
+        let (s, values) = fmu.try_get_reals(&outputs);
+        assert_eq!(s, Fmi2Status::Ok);
+        assert!(
+            values.iter().all(|v| v.is_finite()),
+            "after step {ok_steps} ({status:?}): {values:?}"
+        );
+        if status == Fmi2Status::Ok {
+            t += 0.1;
+            ok_steps += 1;
+        }
+    }
+    assert_eq!(status, Fmi2Status::Discard, "{}", fmu.log_text());
+    assert!(
+        (30..40).contains(&ok_steps),
+        "{ok_steps} steps before the discard"
+    );
+    assert!((fmu.last_successful_time() - t).abs() < 1e-9);
+    let text = fmu.last_text();
+    assert!(
+        text.contains("non-finite value in the step (towline1 length = inf after integration)"),
+        "{text}"
+    );
 }
 
 #[test]

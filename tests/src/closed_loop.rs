@@ -64,7 +64,8 @@ pub struct Trajectory {
     /// controller.
     pub to_controller: Vec<String>,
     pub to_plant: Vec<String>,
-    /// fmi2Warning statuses returned (an MPC fallback is one).
+    /// fmi2Warning statuses returned (an MPC fallback only with the controller's
+    /// `fmi.warning_on_fallback`; `controller.fallbacks` counts them all).
     pub warnings: usize,
 }
 

@@ -56,7 +56,12 @@ fn closed_loop_under_fmi_rs() {
         t.to_controller.len() >= 18 + 7 * 8,
         "vessel states and obstacles"
     );
-    assert_eq!(t.warnings, 0, "no fmi2Warning (no MPC fallback)");
+    assert_eq!(t.warnings, 0, "no fmi2Warning");
+    assert_eq!(
+        *t.column("controller.fallbacks").unwrap().last().unwrap(),
+        0.0,
+        "no MPC fallback"
+    );
     for name in &t.to_plant {
         let command = t.column(name).unwrap();
         assert!(command.iter().all(|v| v.is_finite()), "{name}: {command:?}");

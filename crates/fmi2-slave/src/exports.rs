@@ -149,6 +149,25 @@ impl<M: Fmi2Model> Instance<M> {
         })
     }
 
+    /// The first Real output whose value is not finite, as a message naming it; `None` when
+    /// every one is finite. The layer's guarantee that no step or initialization ends with
+    /// fmi2OK and a non-finite output (FMI 2.0 section 4.2.2: a step whose result is not
+    /// usable is `fmi2Discard`), whatever the model computed. A getter's own error is the
+    /// master's to see when it reads the variable, not a reason here.
+    fn non_finite_output(&self) -> Option<String> {
+        self.desc
+            .variables
+            .iter()
+            .filter(|v| v.causality == Causality::Output && v.value_type() == ValueType::Real)
+            .find_map(|v| match self.model.get_real(v.value_reference) {
+                Ok(x) if !x.is_finite() => Some(format!(
+                    "output '{}' (vr {}) is not finite ({x})",
+                    v.name, v.value_reference
+                )),
+                _ => None,
+            })
+    }
+
     /// The serialized FMU state of `layer` and `model` (format: [`serial`]).
     fn serialize(&self, layer: &LayerState, model: &M) -> Result<Vec<u8>, String> {
         layer.check_continuable()?;
@@ -635,12 +654,16 @@ pub unsafe fn enter_initialization_mode<M: Fmi2Model>(c: Fmi2Component) -> Fmi2S
     }
 }
 
-/// `fmi2ExitInitializationMode` (FMI 2.0 section 2.1.6) → `stepComplete`.
+/// `fmi2ExitInitializationMode` (FMI 2.0 section 2.1.6) → `stepComplete`; a Real output
+/// that is not finite then ([`Instance::non_finite_output`]) is `fmi2Error` naming it.
 pub unsafe fn exit_initialization_mode<M: Fmi2Model>(c: Fmi2Component) -> Fmi2Status {
     // SAFETY: forwarded FMI contract.
     unsafe {
         guard::<M, _>(c, Func::ExitInitializationMode, |inst| {
             inst.model.exit_initialization_mode(&inst.logger)?;
+            if let Some(bad) = inst.non_finite_output() {
+                return Err(format!("{bad} at the end of initialization"));
+            }
             inst.layer.call_state = CallState::StepComplete;
             Ok(Fmi2Status::Ok)
         })
@@ -1181,9 +1204,15 @@ pub unsafe fn get_real_output_derivatives<M: Fmi2Model>(c: Fmi2Component) -> Fmi
 /// `fmi2DoStep` (FMI 2.0 section 4.2.2). Checks `h > 0` and finite,
 /// `currentCommunicationPoint` finite and within `1e-5 * max(1, |t|)` of the internal time
 /// `t`, and `t + h <= stopTime + tol` when a stop time is defined. The internal clock counts
-/// whole nanoseconds and advances by `round(h * 1e9)`. Model outcome: `Ok` → `fmi2OK`;
+/// whole nanoseconds and follows the master's time: the step ends at the master's
+/// `currentCommunicationPoint + h` rounded to the nanosecond ([`step_end_ns`]), so the clock
+/// does not drift from a master that sums its steps, and a step that rounds to no
+/// nanosecond (a master's last step clipped to the stop time, `2.5e-12` s) advances nothing
+/// and returns `fmi2OK` without calling the model. Model outcome: `Ok` → `fmi2OK`;
 /// `Warning` → logged, `fmi2Warning`, time advanced; `Discard` → logged, `fmi2Discard`,
-/// state `stepFailed`, time not advanced; `Error` → `fmi2Error`, state `error`.
+/// state `stepFailed`, time not advanced; `Error` → `fmi2Error`, state `error`. After an
+/// `Ok` or `Warning` every Real output is checked ([`Instance::non_finite_output`]): a
+/// non-finite one turns the step into `fmi2Discard` naming it.
 pub unsafe fn do_step<M: Fmi2Model>(
     c: Fmi2Component,
     current_communication_point: f64,
@@ -1217,33 +1246,31 @@ pub unsafe fn do_step<M: Fmi2Model>(
                     ));
                 }
             }
-            let dh = (h * 1e9).round();
-            if dh < 1.0 {
-                return Err(format!(
-                    "communicationStepSize = {h} is below the 1 ns resolution of the FMU's clock"
-                ));
-            }
-            // 9.2e18 ns ~ 292 years: both checks keep the i64 clock exact and finite.
-            let new_ns = if dh < 9.2e18 {
-                inst.layer.time_ns.checked_add(dh as i64)
-            } else {
-                None
-            };
-            let Some(new_ns) = new_ns else {
+            let Some(new_ns) = step_end_ns(inst.layer.time_ns, tc - t, h) else {
                 return Err(format!(
                     "communicationStepSize = {h} overflows the FMU's nanosecond clock"
                 ));
             };
+            let dns = new_ns - inst.layer.time_ns;
+            if dns == 0 {
+                return Ok(Fmi2Status::Ok);
+            }
             let step = StepContext {
                 current_time: t,
-                step_size: ns_to_s(dh as i64),
+                step_size: ns_to_s(dns),
                 step_index: inst.layer.steps,
             };
             let advance = |inst: &mut Instance<M>| {
                 inst.layer.time_ns = new_ns;
                 inst.layer.steps += 1;
             };
-            match inst.model.do_step(&inst.logger, &step) {
+            let mut outcome = inst.model.do_step(&inst.logger, &step);
+            if matches!(outcome, StepOutcome::Ok | StepOutcome::Warning(_)) {
+                if let Some(bad) = inst.non_finite_output() {
+                    outcome = StepOutcome::Discard(bad);
+                }
+            }
+            match outcome {
                 StepOutcome::Ok => {
                     advance(inst);
                     Ok(Fmi2Status::Ok)
@@ -1267,6 +1294,23 @@ pub unsafe fn do_step<M: Fmi2Model>(
                 StepOutcome::Error(msg) => Err(msg),
             }
         })
+    }
+}
+
+/// The clock (ns since the start time) at the end of `fmi2DoStep(tc, h)` from `now_ns`, where
+/// `lead = tc - t` is how far the master's `currentCommunicationPoint` is ahead of the FMU's
+/// time `t` (within the tolerance `fmi2DoStep` checked): the master's end of step `tc + h`,
+/// rounded to the nanosecond, and never before `now_ns`. With a master whose time is exact
+/// (`lead = 0`) every step is `round(h * 1e9)` ns; with one that sums `t += h` the clock
+/// follows its sum (the clipped last step of such a master, `stop - t` of a few 1e-12 s,
+/// rounds to 0 ns: nothing to advance). `None` when the end overflows the i64 clock.
+fn step_end_ns(now_ns: i64, lead: f64, h: f64) -> Option<i64> {
+    let dns = ((lead + h) * 1e9).round().max(0.0);
+    // 9.2e18 ns ~ 292 years: both checks keep the i64 clock exact and finite.
+    if dns < 9.2e18 {
+        now_ns.checked_add(dns as i64)
+    } else {
+        None
     }
 }
 

@@ -34,9 +34,16 @@
 //!   the stored instantiation context (for `fmi2Reset`) and the `CString` storage behind
 //!   `fmi2GetString`. No global mutable state and no thread-locals: instances are
 //!   independent and may live on different threads.
-//! * **Time** — the clock counts whole nanoseconds since the start time and advances by
-//!   `round(h * 1e9)`, so long runs do not drift; `fmi2DoStep` checks the master's
-//!   communication point against it with tolerance `1e-5 * max(1, |t|)`.
+//! * **Time** — the clock counts whole nanoseconds since the start time; `fmi2DoStep`
+//!   checks the master's communication point `tc` against it with tolerance
+//!   `1e-5 * max(1, |t|)` and ends the step at the master's `tc + h` rounded to the
+//!   nanosecond, so the clock follows a master that sums its steps without drifting from
+//!   it, and a master with exact times gets steps of exactly `round(h * 1e9)` ns. A step
+//!   that rounds to no nanosecond (the clipped last step of a summing master) advances
+//!   nothing and is `fmi2OK` (FMI 2.0 section 4.2.2 asks only `h > 0`).
+//! * **Finite outputs** — after every step and at the end of initialization the layer
+//!   reads every Real output: a non-finite one makes the step `fmi2Discard` (the end of
+//!   initialization `fmi2Error`), naming it.
 //! * **FMU state** (section 2.1.8) — `fmi2GetFMUstate` boxes a clone of the model plus the
 //!   layer state; `fmi2SetFMUstate` restores it with [`Fmi2Model::restore_state`], which
 //!   keeps what is the instance's own (its log). The serialized form is versioned,
@@ -103,9 +110,12 @@ pub struct StepContext {
     /// layer's nanosecond clock (within `1e-5 * max(1, |t|)` of the master's
     /// `currentCommunicationPoint`).
     pub current_time: f64,
-    /// The step in seconds, rounded to whole nanoseconds: `round(h * 1e9) / 1e9`.
+    /// The step in seconds, whole nanoseconds: from the FMU's time to the master's
+    /// `currentCommunicationPoint + h` rounded to the nanosecond (`round(h * 1e9) / 1e9` when
+    /// the master's time equals the FMU's); never 0 (an empty step does not reach the model).
     pub step_size: f64,
-    /// Number of steps accepted since the start (0 for the first step).
+    /// Number of steps accepted since the start (0 for the first step); empty steps (no
+    /// nanosecond to advance) are not counted.
     pub step_index: u64,
 }
 

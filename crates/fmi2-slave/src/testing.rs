@@ -118,6 +118,42 @@ macro_rules! exports_of {
     };
 }
 
+/// The `fmi2DoStep` arguments `(currentCommunicationPoint, communicationStepSize)` of a
+/// master that keeps its time as a running sum and clips the last step at the stop time
+/// (OMSimulator's fixed-step loop, and many a hand-written one): `t_next = min(t + h, stop)`,
+/// `h_k = t_next - t`, from `start` until the sum reaches `stop`. The sum drifts from `k h`
+/// in its last bits, so the last step is often a few 1e-12 s: 0.1 s steps to 120 s end with
+/// one of 2.5437429940211587e-12 s.
+#[must_use]
+pub fn summing_master_steps(start: f64, stop: f64, h: f64) -> Vec<(f64, f64)> {
+    let mut steps = Vec::new();
+    let mut t = start;
+    while t < stop {
+        let next = (t + h).min(stop);
+        steps.push((t, next - t));
+        t = next;
+    }
+    steps
+}
+
+/// The stop times at which OMSimulator, summing `t += 0.1`, ended with a sub-nanosecond
+/// step that the FMUs once refused (issue 15).
+pub const SUMMING_MASTER_STOP_TIMES: [f64; 5] = [1.0, 10.0, 100.0, 120.0, 300.0];
+
+/// Steps the initialized `fmu` from 0 to `stop` as [`summing_master_steps`] with step `h`:
+/// every step is fmi2OK and the FMU ends at `stop` exactly.
+pub fn assert_summing_master_reaches(fmu: &Fmu, stop: f64, h: f64) {
+    for (k, (t, hk)) in summing_master_steps(0.0, stop, h).into_iter().enumerate() {
+        assert_eq!(
+            fmu.step(t, hk),
+            Fmi2Status::Ok,
+            "stop {stop}, step {k}: doStep({t}, {hk:e}): {}",
+            fmu.log_text()
+        );
+    }
+    assert_eq!(fmu.last_successful_time(), stop);
+}
+
 /// One message the FMU sent to the logger.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Msg {

@@ -11,7 +11,7 @@ use std::ptr;
 
 use common::*;
 use fmi2_slave::ffi::*;
-use fmi2_slave::testing::Fmu;
+use fmi2_slave::testing::{self, Fmu};
 use fmi2_slave::Fmi2Status;
 
 /// The model's own arithmetic, replicated: Euler substeps of y' = (u - y) / T.
@@ -56,6 +56,54 @@ fn clock_counts_nanoseconds_and_does_not_drift() {
     );
 }
 
+/// A master that sums `t += 0.1` and clips its last step at the stop time (OMSimulator)
+/// sends a last step of a few 1e-12 s: every step is fmi2OK, the clock ends at the stop time
+/// exactly, and the model integrated exactly `10 stop` steps of 0.1 s (the empty last step
+/// does not reach it).
+#[test]
+fn a_summing_master_reaches_every_stop_time_with_fmi2ok() {
+    for stop in testing::SUMMING_MASTER_STOP_TIMES {
+        let steps = testing::summing_master_steps(0.0, stop, 0.1);
+        let last = steps.last().unwrap().1;
+        assert!(
+            last < 1e-9,
+            "stop {stop}: the sum's last step {last} is sub-ns"
+        );
+        let f = new_fmu("summing");
+        assert_eq!(f.set_real(R_U, 1.0), Fmi2Status::Ok);
+        f.init(0.0, Some(stop));
+        testing::assert_summing_master_reaches(&f, stop, 0.1);
+        let n = (stop * 10.0).round() as i32;
+        assert_eq!(f.get_integer(I_STEPS), n, "stop {stop}");
+        let y_ref = (0..n).fold(0.0, |y, _| reference_step(y, 1.0, 1.0, 0.1, 4));
+        assert_eq!(f.get_real(R_Y).to_bits(), y_ref.to_bits(), "stop {stop}");
+    }
+}
+
+/// Steps below the clock's resolution: the clock follows the master's sum of them (to the
+/// nanosecond) instead of dropping each one, and never goes backwards.
+#[test]
+fn sub_nanosecond_steps_follow_the_masters_sum() {
+    let f = new_fmu("sub_ns");
+    f.init(0.0, None);
+    let (mut t, h) = (0.0, 0.3e-9);
+    let mut previous = 0.0;
+    for k in 0..1000 {
+        assert_eq!(f.step(t, h), Fmi2Status::Ok, "step {k}");
+        t += h;
+        let now = f.last_successful_time();
+        assert!(now >= previous, "step {k}: the clock went back");
+        assert!(
+            (now - t).abs() <= 0.5e-9 + 1e-18,
+            "step {k}: {now} vs the master's {t}"
+        );
+        previous = now;
+    }
+    // 300 ns in whole-nanosecond model steps.
+    assert_eq!(f.last_successful_time(), 3e-7);
+    assert_eq!(f.get_integer(I_STEPS), 300);
+}
+
 #[test]
 fn start_time_offsets_the_clock() {
     let f = new_fmu("start");
@@ -68,7 +116,10 @@ fn start_time_offsets_the_clock() {
         Fmi2Status::Ok,
         "within 1e-5 * max(1, |t|)"
     );
-    assert_eq!(f.last_successful_time(), 5.5);
+    // The step ends at the master's end of step, to the nanosecond: the clock follows it.
+    assert!((f.last_successful_time() - 5.500_001).abs() < 1e-12);
+    assert_eq!(f.step(5.500_001, 0.499_999), Fmi2Status::Ok);
+    assert_eq!(f.last_successful_time(), 6.0);
 }
 
 #[test]
@@ -123,12 +174,6 @@ fn do_step_rejects_bad_arguments_with_the_numbers() {
             2.0,
             "currentCommunicationPoint + communicationStepSize = 0 + 2 = 2 exceeds stopTime = 1",
         ),
-        (
-            None,
-            0.0,
-            1e-10,
-            "communicationStepSize = 0.0000000001 is below the 1 ns resolution",
-        ),
         (None, 0.0, 1e12, "overflows the FMU's nanosecond clock"),
     ];
     for (stop, t, h, fragment) in cases {
@@ -148,6 +193,67 @@ fn do_step_rejects_bad_arguments_with_the_numbers() {
     let f = new_fmu("edge");
     f.init(0.0, Some(1.0));
     assert_eq!(f.step(1e-6, 1.0 + 1e-6), Fmi2Status::Ok);
+}
+
+/// A step that ends with a non-finite output is fmi2Discard naming it, whatever the model
+/// returned (FMI 2.0 section 4.2.2): the time stays at the step's start, the instance is
+/// stepFailed, and a restored state steps on.
+#[test]
+fn a_non_finite_output_discards_the_step_naming_it() {
+    let f = new_fmu("overflow");
+    assert_eq!(f.set_real(R_T, 1e-3), Fmi2Status::Ok);
+    f.init(0.0, None);
+    assert_eq!(f.step(0.0, 0.1), Fmi2Status::Ok);
+    let before = f.get_state();
+    // y' = (u - y) / T overflows: the model itself reports fmi2OK.
+    assert_eq!(f.set_real(R_U, 1.7e308), Fmi2Status::Ok);
+    assert_eq!(f.step(0.1, 0.1), Fmi2Status::Discard, "{:?}", f.messages());
+    let m = f.messages().pop().unwrap();
+    assert_eq!(m.status, Fmi2Status::Discard as c_int);
+    assert_eq!(m.category, "logStatusDiscard");
+    assert!(
+        m.text.starts_with(
+            "fmi2DoStep: step from t = 0.1 with h = 0.1 discarded: output 'y' (vr 2) is not finite ("
+        ),
+        "{}",
+        m.text
+    );
+    assert!(m.text.ends_with("; last successful time 0.1"), "{}", m.text);
+    assert_eq!(f.last_successful_time(), 0.1);
+    assert_eq!(f.step(0.1, 0.1), Fmi2Status::Error, "stepFailed");
+    // The master restores the state of 0.1 s and steps on with a finite input.
+    unsafe {
+        assert_eq!(fmi2SetFMUstate(f.c, before), Fmi2Status::Ok);
+        f.free_state(before);
+    }
+    assert_eq!(f.set_real(R_U, 1.0), Fmi2Status::Ok);
+    assert_eq!(f.step(0.1, 0.1), Fmi2Status::Ok);
+    assert!(f.get_real(R_Y).is_finite());
+    // A warning with a non-finite output is a discard too.
+    let f = new_fmu("warning_nan");
+    f.init(0.0, None);
+    assert_eq!(f.set_integer(I_FAULT, FAULT_WARNING), Fmi2Status::Ok);
+    assert_eq!(f.step(0.0, 0.1), Fmi2Status::Warning);
+    assert_eq!(f.set_integer(I_FAULT, FAULT_NAN), Fmi2Status::Ok);
+    assert_eq!(f.step(0.1, 0.1), Fmi2Status::Discard);
+    assert!(f
+        .last_text()
+        .contains("output 'y' (vr 2) is not finite (NaN)"));
+}
+
+/// Initialization that ends with a non-finite output is fmi2Error naming it.
+#[test]
+fn a_non_finite_output_after_initialization_is_an_error_naming_it() {
+    let f = new_fmu("init_nan");
+    assert_eq!(f.setup(0.0, None), Fmi2Status::Ok);
+    assert_eq!(f.enter_init(), Fmi2Status::Ok);
+    assert_eq!(f.set_integer(I_FAULT, FAULT_NAN), Fmi2Status::Ok);
+    assert_eq!(f.exit_init(), Fmi2Status::Error);
+    assert_eq!(
+        f.last_text(),
+        "fmi2ExitInitializationMode: output 'y' (vr 2) is not finite (NaN) at the end of initialization"
+    );
+    assert_eq!(f.step(0.0, 0.1), Fmi2Status::Error, "error state");
 }
 
 #[test]

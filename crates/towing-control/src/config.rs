@@ -285,6 +285,11 @@ pub struct Tuning {
     pub inner: InnerLoopParams,
     /// How the MPC tracks the reference system's output.
     pub tracking: TrackingParams,
+    /// The FMU only: a sample that falls back makes `fmi2DoStep` return
+    /// `fmi2Warning` (`true`) or `fmi2OK` (`false`, the default); the fallback
+    /// is logged and counted either way. The Rust controller reports every
+    /// fallback in its [`crate::SampleReport`] and ignores this.
+    pub warning_on_fallback: bool,
 }
 
 impl Default for Tuning {
@@ -304,6 +309,7 @@ impl Default for Tuning {
             waterway: WaterwaySettings::default(),
             inner: InnerLoopParams::default(),
             tracking: TrackingParams::default(),
+            warning_on_fallback: false,
         }
     }
 }

@@ -6,14 +6,21 @@
 //!    valid); a refused measurement leaves the controller unchanged;
 //! 2. the ship reference system (eq. (8)-(11)) gives `eta_Sd` and the COLREGS
 //!    situation of every target; scheme III follows the unaltered route instead;
-//! 3. the obstacles nearest to the tow (at most the QP's clearance slots) become
+//! 3. a measurement that describes no tow (two vessels closer than half a beam,
+//!    [`Overlap`]: e.g. inputs never set, every vessel at (0, 0)) is not
+//!    solved: the rest command is applied ([`Rest`]; not a fallback);
+//! 4. the obstacles nearest to the tow (at most the QP's clearance slots) become
 //!    the MPC's obstacles, at their measured pose (held over the horizon);
-//! 4. the MPC (ADMM, Algorithm 1, or the centralized problem) computes the plan;
-//! 5. if a subproblem's last solve failed or the plan is not finite, the
-//!    previous sample's plan, shifted by one sample and held within the bounds
-//!    and rate bounds, is applied instead, the fallback is counted and the
-//!    reason returned (the FMU turns it into `fmi2Warning`), and the next sample
+//! 5. the MPC (ADMM, Algorithm 1, or the centralized problem) computes the plan;
+//! 6. if a subproblem's last solve failed or the plan (or its prediction) is not
+//!    finite, the previous sample's plan, shifted by one sample and held within
+//!    the bounds and rate bounds, is applied instead, the fallback is counted and
+//!    the reason returned (the FMU logs it as a warning), and the next sample
 //!    starts cold.
+//!
+//! Every value of the report is finite: a residual of an iterate that
+//! overflowed is reported as `f64::MAX`, and the prediction of a fallback is
+//! the measured state held where its rollout overflows.
 //!
 //! Between samples, [`Controller::command_at`] adds the tugs' inner loop
 //! ([`InnerLoopParams`]) to the held tug thrusts; the tensions hold.
@@ -34,9 +41,9 @@ use towing_model::{
     wrap_angle, ObstacleKind, ObstacleSlot, Pose, VesselData, VesselState, World, MAX_OBSTACLES,
 };
 use towing_mpc::{
-    Admm, AdmmBuildError, AppliedCommand, Budget, Centralized, FormationMap, Obstacle, Optimizer,
-    OptimizerState, PredictionHull, QpOutcome, SampleInput, ShipInput, ShipModel, ShipMpc,
-    TugInput, TugModel, TugMpc, HORIZON,
+    Admm, AdmmBuildError, AppliedCommand, Budget, Centralized, FormationMap, MpcReport, Obstacle,
+    Optimizer, OptimizerState, PredictionHull, QpOutcome, SampleInput, ShipInput, ShipModel,
+    ShipMpc, TugInput, TugModel, TugMpc, HORIZON,
 };
 
 use crate::config::{Architecture, ControllerConfig, InnerLoopParams};
@@ -164,6 +171,9 @@ pub struct SampleReport {
     pub fallback: Option<Fallback>,
     /// Fallbacks since instantiation.
     pub fallbacks: u64,
+    /// Set when the measurement does not describe a tow ([`Overlap`]): the
+    /// sample applied the rest command instead of solving (not a fallback).
+    pub rest: Option<Rest>,
     /// The heading floor of this sample (rad; `None`: none): no turn to port
     /// during a head-on or crossing encounter ([`TrackingParams::port_turn_margin`]).
     pub heading_floor: Option<f64>,
@@ -212,6 +222,16 @@ pub enum StepError {
     },
 }
 
+/// The optimiser's report of a sample at rest ([`Rest`]): nothing solved.
+const REST_REPORT: MpcReport = MpcReport {
+    iterations: 0,
+    converged: false,
+    budget_hit: false,
+    failed: None,
+    r_pri: [0.0; 2],
+    r_dual: [0.0; 2],
+};
+
 /// A communication point within this of a sample instant samples (1 us).
 pub const SAMPLE_TOLERANCE: Duration = Duration::from_micros(1);
 const SAMPLE_TOLERANCE_NS: i64 = 1_000;
@@ -237,7 +257,7 @@ pub enum Fallback {
         /// Clarabel's outcome.
         outcome: QpOutcome,
     },
-    /// The plan holds a NaN or an infinity.
+    /// The plan, or the states it predicts, hold a NaN or an infinity.
     NonFinitePlan,
 }
 
@@ -247,7 +267,7 @@ impl std::fmt::Display for Fallback {
             Fallback::SolveFailed { problem, outcome } => {
                 write!(f, "the {problem} QP gave no usable solution ({outcome:?})")
             }
-            Fallback::NonFinitePlan => write!(f, "the plan is not finite"),
+            Fallback::NonFinitePlan => write!(f, "the plan or its prediction is not finite"),
         }
     }
 }
@@ -279,6 +299,48 @@ pub struct ControllerState {
     /// The reference course of the last sample.
     course: Option<f64>,
     clock: Clock,
+    /// The last sample rested (a measurement describing no tow).
+    resting: bool,
+}
+
+/// Two vessels of a measurement closer than half the larger one's beam: one
+/// centre lies inside the other's hull (a hull contains the disc of its half
+/// beam about its centre), which no tow can be in. What a controller sees whose
+/// inputs were never set (every vessel at their start value (0, 0), as
+/// fmuCheck, fmusim and `fmpy.simulate_fmu` run an FMU alone).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Overlap {
+    /// The two vessels (`ship`, `tug1`, `tug2`).
+    pub vessels: [&'static str; 2],
+    /// The distance between their centres (m).
+    pub distance: f64,
+    /// Half the larger beam (m).
+    pub limit: f64,
+}
+
+impl std::fmt::Display for Overlap {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let [a, b] = self.vessels;
+        write!(
+            f,
+            "the measured {b} is {} m from the {a}, less than half a beam ({} m): one lies inside \
+             the other's hull, so the inputs describe no tow (inputs never set are all 0, every \
+             vessel at (0, 0))",
+            self.distance, self.limit
+        )
+    }
+}
+
+/// A sample that applied the rest command (the tensions towards the
+/// pretension and the angles towards zero within their rate bounds, no thrust)
+/// because the measurement describes no tow.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rest {
+    /// Why.
+    pub overlap: Overlap,
+    /// Whether the sample before solved (or there was none): this one begins a
+    /// run of resting samples, the one to report.
+    pub first: bool,
 }
 
 /// The controller (module docs).
@@ -310,6 +372,8 @@ pub struct Controller {
     clock: Clock,
     /// A copy of the last sample's MPC input ([`Controller::last_mpc_input`]).
     last_input: Option<MpcInput>,
+    /// The last sample rested ([`Rest`]).
+    resting: bool,
 }
 
 fn mass_matrix(d: &VesselData) -> [[f64; 3]; 3] {
@@ -381,6 +445,7 @@ impl Controller {
                 ..Clock::default()
             },
             last_input: None,
+            resting: false,
         })
     }
 
@@ -406,6 +471,7 @@ impl Controller {
             course,
             clock,
             last_input: _,
+            resting,
         } = self;
         ControllerState {
             guidance: guidance.clone(),
@@ -420,6 +486,7 @@ impl Controller {
             port_turn_anchor: *port_turn_anchor,
             course: *course,
             clock: *clock,
+            resting: *resting,
         }
     }
 
@@ -459,6 +526,7 @@ impl Controller {
         self.port_turn_anchor = state.port_turn_anchor;
         self.course = state.course;
         self.clock = state.clock;
+        self.resting = state.resting;
         Ok(())
     }
 
@@ -497,6 +565,56 @@ impl Controller {
         let start = Instant::now();
         m.validate()?;
         let guided = self.guide(m)?;
+        let rest = self.overlap(m).map(|overlap| Rest {
+            overlap,
+            first: !self.resting,
+        });
+        self.resting = rest.is_some();
+        let (report, (ship_cmd, tug_cmd, fallback)) = if rest.is_some() {
+            (REST_REPORT, self.rest())
+        } else {
+            let report = self.solve(m, &guided, start);
+            (report, self.apply(report.failed))
+        };
+        let prediction = self.prediction(m, fallback.is_none() && rest.is_none());
+        for i in 0..2 {
+            self.nu_start[i] = [m.tugs[i][3], m.tugs[i][4], m.tugs[i][5]];
+            self.nu_end[i] = [
+                prediction.tugs[i][0][3],
+                prediction.tugs[i][0][4],
+                prediction.tugs[i][0][5],
+            ];
+        }
+        // A residual of an iterate that overflowed (the sample then fell back):
+        // the largest finite value, never NaN.
+        let residual = |r: [f64; 2]| r.map(|v| finite_or(v, f64::MAX));
+        Ok(SampleReport {
+            command: Command {
+                tug_thrust: tug_cmd,
+                tension: [ship_cmd[0], ship_cmd[1]],
+            },
+            desired_angle: [ship_cmd[2], ship_cmd[3]],
+            guidance: guided.output,
+            reference: guided.reference,
+            situation: guided.situation,
+            role: guided.role,
+            iterations: report.iterations,
+            converged: report.converged,
+            budget_hit: report.budget_hit,
+            r_pri: residual(report.r_pri),
+            r_dual: residual(report.r_dual),
+            compute_time: start.elapsed().as_secs_f64(),
+            fallback,
+            fallbacks: self.fallbacks,
+            rest,
+            heading_floor: guided.heading_floor,
+            prediction,
+        })
+    }
+
+    /// The MPC's part of a sample: its obstacles (nearest first), its input, the
+    /// optimisation within the sample's time budget.
+    fn solve(&mut self, m: &Measurement, guided: &Guided, start: Instant) -> MpcReport {
         let (n_obstacles, distance_cost_off) = self.select_obstacles(m);
         let input = SampleInput {
             ship: m.ship,
@@ -513,38 +631,38 @@ impl Controller {
             start,
             (budget_s > 0.0).then(|| Duration::from_secs_f64(budget_s)),
         );
-        let report = self.solver.solve(&input, budget);
-        let (ship_cmd, tug_cmd, fallback) = self.apply(report.failed);
-        let prediction = self.prediction(m, fallback.is_none());
-        for i in 0..2 {
-            self.nu_start[i] = [m.tugs[i][3], m.tugs[i][4], m.tugs[i][5]];
-            self.nu_end[i] = [
-                prediction.tugs[i][0][3],
-                prediction.tugs[i][0][4],
-                prediction.tugs[i][0][5],
-            ];
-        }
-        Ok(SampleReport {
-            command: Command {
-                tug_thrust: tug_cmd,
-                tension: [ship_cmd[0], ship_cmd[1]],
-            },
-            desired_angle: [ship_cmd[2], ship_cmd[3]],
-            guidance: guided.output,
-            reference: guided.reference,
-            situation: guided.situation,
-            role: guided.role,
-            iterations: report.iterations,
-            converged: report.converged,
-            budget_hit: report.budget_hit,
-            r_pri: report.r_pri,
-            r_dual: report.r_dual,
-            compute_time: start.elapsed().as_secs_f64(),
-            fallback,
-            fallbacks: self.fallbacks,
-            heading_floor: guided.heading_floor,
-            prediction,
+        self.solver.solve(&input, budget)
+    }
+
+    /// The first two vessels of `m` closer than half the larger beam
+    /// ([`Overlap`]), if any.
+    fn overlap(&self, m: &Measurement) -> Option<Overlap> {
+        let s = &self.config.scenario;
+        let vessels = [
+            (&m.ship, s.ship_data.width),
+            (&m.tugs[0], s.tug_data[0].width),
+            (&m.tugs[1], s.tug_data[1].width),
+        ];
+        [(0, 1), (0, 2), (1, 2)].into_iter().find_map(|(a, b)| {
+            let ((pa, wa), (pb, wb)) = (vessels[a], vessels[b]);
+            let distance = (pa[0] - pb[0]).hypot(pa[1] - pb[1]);
+            let limit = 0.5 * wa.max(wb);
+            (distance < limit).then_some(Overlap {
+                vessels: [VESSEL_NAMES[a], VESSEL_NAMES[b]],
+                distance,
+                limit,
+            })
         })
+    }
+
+    /// A sample at rest ([`Rest`]): the rest command within the rate bounds;
+    /// no plan to keep, and the next solved sample starts cold.
+    fn rest(&mut self) -> (ShipInput, [TugInput; 2], Option<Fallback>) {
+        self.solver.reset();
+        self.spare_left = 0;
+        let (ship, tugs) = self.within_bounds(self.rest_plan());
+        self.applied = AppliedCommand { ship, tugs };
+        (ship, tugs, None)
     }
 
     /// The reference system's part of a sample: the reference to track, the
@@ -595,7 +713,7 @@ impl Controller {
     }
 
     /// The command of a solved sample (the plan's first move), or the fallback
-    /// if a subproblem failed or the plan is not finite; keeps the next
+    /// if a subproblem failed or the plan (or its prediction) is not finite; keeps the next
     /// sample's spare plan and warm start, and records the applied command.
     fn apply(
         &mut self,
@@ -603,8 +721,20 @@ impl Controller {
     ) -> (ShipInput, [TugInput; 2], Option<Fallback>) {
         let ship_plan = self.solver.ship_plan();
         let tug_plans = [self.solver.tug_plan(0), self.solver.tug_plan(1)];
+        let tug_predicted = [self.solver.tug_predicted(0), self.solver.tug_predicted(1)];
         let finite = ship_plan.iter().flatten().all(|v| v.is_finite())
-            && tug_plans.iter().flatten().flatten().all(|v| v.is_finite());
+            && tug_plans.iter().flatten().flatten().all(|v| v.is_finite())
+            && self
+                .solver
+                .ship_predicted()
+                .iter()
+                .flatten()
+                .all(|v| v.is_finite())
+            && tug_predicted
+                .iter()
+                .flatten()
+                .flatten()
+                .all(|v| v.is_finite());
         let fallback = if let Some((problem, outcome)) = failed {
             Some(Fallback::SolveFailed { problem, outcome })
         } else if !finite {
@@ -883,20 +1013,40 @@ impl Controller {
 
     /// The spare plan's first sample, within the bounds and rate bounds of the
     /// applied command. Once the spare plan is used up (or without one), the
-    /// command goes to rest: the tensions to the pretension and the angles to
-    /// zero at their rate bounds, no thrust; the tow then drifts to a stop.
+    /// command goes to rest ([`Controller::rest_plan`]); the tow then drifts to a
+    /// stop.
     fn fallback_command(&mut self) -> (ShipInput, [TugInput; 2]) {
+        let have_spare = self.spare_left > 0;
+        self.spare_left = self.spare_left.saturating_sub(1);
+        let wanted = if have_spare {
+            (
+                self.spare_ship[0],
+                [self.spare_tugs[0][0], self.spare_tugs[1][0]],
+            )
+        } else {
+            self.rest_plan()
+        };
+        self.within_bounds(wanted)
+    }
+
+    /// At rest: the tensions at the pretension, the angles at zero, no thrust.
+    fn rest_plan(&self) -> (ShipInput, [TugInput; 2]) {
+        let p = &self.config.tuning.ship;
+        ([p.min_tension, p.min_tension, 0.0, 0.0], [[0.0; 3]; 2])
+    }
+
+    /// `wanted` as near as one sample allows: the tensions and angles within
+    /// their bounds and their rate bounds from the applied command (a value not
+    /// finite holds the applied one), the thrusts within their limits (not
+    /// finite: 0).
+    fn within_bounds(
+        &self,
+        (wanted, wanted_tugs): (ShipInput, [TugInput; 2]),
+    ) -> (ShipInput, [TugInput; 2]) {
         let p = &self.config.tuning.ship;
         let ts = self.config.tuning.prediction.sample_time;
         let (tension_step, angle_step) = (p.tension_rate * ts, p.angle_rate * ts);
         let prev = self.applied.ship;
-        let have_spare = self.spare_left > 0;
-        self.spare_left = self.spare_left.saturating_sub(1);
-        let wanted = if have_spare {
-            self.spare_ship[0]
-        } else {
-            [p.min_tension, p.min_tension, 0.0, 0.0]
-        };
         let mut ship = [0.0; 4];
         for i in 0..2 {
             let lo = (prev[i] - tension_step).max(p.min_tension);
@@ -907,14 +1057,9 @@ impl Controller {
             ship[2 + i] = finite_or(wanted[2 + i], prev[2 + i]).clamp(lo.min(hi), hi);
         }
         let tugs = std::array::from_fn(|i| {
-            let w = if have_spare {
-                self.spare_tugs[i][0]
-            } else {
-                [0.0; 3]
-            };
             std::array::from_fn(|c| {
                 let l = self.thrust_limit[i][c];
-                finite_or(w[c], 0.0).clamp(-l, l)
+                finite_or(wanted_tugs[i][c], 0.0).clamp(-l, l)
             })
         });
         (ship, tugs)
@@ -965,8 +1110,16 @@ impl Controller {
         (used, off)
     }
 
+    /// The predicted states of the applied command: the plan's (finite, checked
+    /// in [`Controller::apply`]); without a plan (a fallback, a rest) the ship's
+    /// rollout of the applied command, or the measured states held where that
+    /// rollout is not finite (speeds far beyond the model's range), and the tugs
+    /// held.
     fn prediction(&self, m: &Measurement, from_plan: bool) -> Prediction {
-        let mut out = Prediction::default();
+        let mut out = Prediction {
+            ship: [m.ship; HORIZON],
+            tugs: [[m.tugs[0]; HORIZON], [m.tugs[1]; HORIZON]],
+        };
         if from_plan {
             out.ship = *self.solver.ship_predicted();
             for i in 0..2 {
@@ -974,9 +1127,9 @@ impl Controller {
             }
         } else {
             let model: &ShipModel = self.solver.ship_model();
-            out.ship = model.rollout::<HORIZON>(&m.ship, &[self.applied.ship; HORIZON]);
-            for i in 0..2 {
-                out.tugs[i] = [m.tugs[i]; HORIZON];
+            let rollout = model.rollout::<HORIZON>(&m.ship, &[self.applied.ship; HORIZON]);
+            if rollout.iter().flatten().all(|v| v.is_finite()) {
+                out.ship = rollout;
             }
         }
         out

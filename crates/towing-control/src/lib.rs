@@ -36,7 +36,7 @@ pub use config::{
 };
 pub use controller::{
     centralized_mpc, mpc_params, Command, Controller, ControllerState, Fallback, Measurement,
-    Prediction, SampleReport, Step, StepError, SAMPLE_TOLERANCE,
+    Overlap, Prediction, Rest, SampleReport, Step, StepError, SAMPLE_TOLERANCE,
 };
 pub use error::{ConfigError, MeasurementError};
 pub use mpc_input::MpcInput;

@@ -18,6 +18,7 @@
 //! | `waterway` | the waterway's half width |
 //! | `tracking` | how the MPC tracks the reference (lookahead, line of sight, heading floor) |
 //! | `inner_loop` | the tugs' inner stabilising loop |
+//! | `fmi` | how the FMU reports to its master (fmi2DoStep statuses) |
 //!
 //! `architecture` and `avoidance_scheme` keep their ungrouped names (the masters
 //! and the interface contract use them). Every Real declares its unit, one unit
@@ -270,54 +271,6 @@ pub static PARAMETERS: &[Parameter] = &[
             max: Limit::None,
             get: |t| t.ship.weight_port_turn,
             set: |t, v| t.ship.weight_port_turn = v,
-        },
-    },
-    Parameter {
-        name: "mpc.ship.max_drift",
-        old_name: None,
-        description: "Soft limit of the ship's predicted drift angle: |v| <= tan(max_drift) u + 0.005 m/s (seamanship, docs/colregs.md); 22 deg, inside the 30 deg bound (docs/assumptions.md)",
-        kind: Kind::Real {
-            unit: "rad",
-            min: Limit::Above(0.0),
-            max: Limit::Below(std::f64::consts::FRAC_PI_2),
-            get: |t| t.ship.motion.max_drift,
-            set: |t, v| t.ship.motion.max_drift = v,
-        },
-    },
-    Parameter {
-        name: "mpc.ship.max_sternway",
-        old_name: None,
-        description: "Soft limit of the ship's predicted surge astern; 0.01 m/s, inside the 0.03 m/s bound (docs/assumptions.md)",
-        kind: Kind::Real {
-            unit: "m/s",
-            min: Limit::AtLeast(0.0),
-            max: Limit::None,
-            get: |t| t.ship.motion.max_sternway,
-            set: |t, v| t.ship.motion.max_sternway = v,
-        },
-    },
-    Parameter {
-        name: "mpc.ship.max_speed",
-        old_name: None,
-        description: "Soft limit of the ship's predicted surge ahead; 0.11 m/s, about 1.2 times the tow's cruise (docs/assumptions.md)",
-        kind: Kind::Real {
-            unit: "m/s",
-            min: Limit::Above(0.0),
-            max: Limit::None,
-            get: |t| t.ship.motion.max_speed,
-            set: |t, v| t.ship.motion.max_speed = v,
-        },
-    },
-    Parameter {
-        name: "mpc.ship.motion_penalty",
-        old_name: None,
-        description: "Exact L1 penalty on the slack of the motion limits (drift, sternway, speed); 1e4 as the clearance rows; 0 turns the limits off",
-        kind: Kind::Real {
-            unit: "s/m",
-            min: Limit::AtLeast(0.0),
-            max: Limit::None,
-            get: |t| t.ship.motion.penalty,
-            set: |t, v| t.ship.motion.penalty = v,
         },
     },
     Parameter {
@@ -733,30 +686,6 @@ pub static PARAMETERS: &[Parameter] = &[
         },
     },
     Parameter {
-        name: "tracking.course_rate",
-        old_name: None,
-        description: "Largest rate at which the reference course turns towards the line of sight to the tracked point, whose position is kept on that course (no sideways or astern reference after an alteration is released); 1.5 deg/s, about the yaw rate the tow reaches in the paper's alterations (docs/assumptions.md); 0: no limit",
-        kind: Kind::Real {
-            unit: "rad/s",
-            min: Limit::AtLeast(0.0),
-            max: Limit::Below(std::f64::consts::PI),
-            get: |t| t.tracking.course_rate,
-            set: |t, v| t.tracking.course_rate = v,
-        },
-    },
-    Parameter {
-        name: "tracking.course_lead",
-        old_name: None,
-        description: "Largest angle between the reference course and the ship's heading: the tracked point leads a turn the ship is making but never lies abeam of her (seamanship: drift angle under 30 deg); 20 deg (docs/assumptions.md); 0: no limit",
-        kind: Kind::Real {
-            unit: "rad",
-            min: Limit::AtLeast(0.0),
-            max: Limit::Below(std::f64::consts::PI),
-            get: |t| t.tracking.course_lead,
-            set: |t, v| t.tracking.course_lead = v,
-        },
-    },
-    Parameter {
         name: "inner_loop.bandwidth_surge",
         old_name: Some("inner_loop_gain_surge"),
         description: "Surge bandwidth of the tugs' inner loop (K = diag(bandwidth) M added to the MPC thrust every communication step); 1/s moves the TitoNeri's unstable sway-yaw pole to about -0.5 1/s (docs/controller-design.md); 0 turns the axis off",
@@ -790,6 +719,87 @@ pub static PARAMETERS: &[Parameter] = &[
             max: Limit::None,
             get: |t| t.inner.gain[2],
             set: |t, v| t.inner.gain[2] = v,
+        },
+    },
+    Parameter {
+        name: "fmi.warning_on_fallback",
+        old_name: None,
+        description: "true: a control sample that falls back (its plan replaced by the previous plan, shifted) makes fmi2DoStep return fmi2Warning (FMI 2.0 section 4.2.2), which stops masters that end on any status above fmi2OK (fmusim, OMSimulator); false: fmi2OK. Either way the fallback is logged as a warning (category logStatusWarning, and the MCAP log's /controller/log) and counted in controller.fallbacks",
+        kind: Kind::Boolean {
+            get: |t| t.warning_on_fallback,
+            set: |t, v| t.warning_on_fallback = v,
+        },
+    },
+    Parameter {
+        name: "mpc.ship.max_drift",
+        old_name: None,
+        description: "Soft limit of the ship's predicted drift angle: |v| <= tan(max_drift) u + 0.005 m/s (seamanship, docs/colregs.md); 22 deg, inside the 30 deg bound (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "rad",
+            min: Limit::Above(0.0),
+            max: Limit::Below(std::f64::consts::FRAC_PI_2),
+            get: |t| t.ship.motion.max_drift,
+            set: |t, v| t.ship.motion.max_drift = v,
+        },
+    },
+    Parameter {
+        name: "mpc.ship.max_sternway",
+        old_name: None,
+        description: "Soft limit of the ship's predicted surge astern; 0.01 m/s, inside the 0.03 m/s bound (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "m/s",
+            min: Limit::AtLeast(0.0),
+            max: Limit::None,
+            get: |t| t.ship.motion.max_sternway,
+            set: |t, v| t.ship.motion.max_sternway = v,
+        },
+    },
+    Parameter {
+        name: "mpc.ship.max_speed",
+        old_name: None,
+        description: "Soft limit of the ship's predicted surge ahead; 0.11 m/s, about 1.2 times the tow's cruise (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "m/s",
+            min: Limit::Above(0.0),
+            max: Limit::None,
+            get: |t| t.ship.motion.max_speed,
+            set: |t, v| t.ship.motion.max_speed = v,
+        },
+    },
+    Parameter {
+        name: "mpc.ship.motion_penalty",
+        old_name: None,
+        description: "Exact L1 penalty on the slack of the motion limits (drift, sternway, speed); 1e4 as the clearance rows; 0 turns the limits off",
+        kind: Kind::Real {
+            unit: "s/m",
+            min: Limit::AtLeast(0.0),
+            max: Limit::None,
+            get: |t| t.ship.motion.penalty,
+            set: |t, v| t.ship.motion.penalty = v,
+        },
+    },
+    Parameter {
+        name: "tracking.course_rate",
+        old_name: None,
+        description: "Largest rate at which the reference course turns towards the line of sight to the tracked point, whose position is kept on that course (no sideways or astern reference after an alteration is released); 1.5 deg/s, about the yaw rate the tow reaches in the paper's alterations (docs/assumptions.md); 0: no limit",
+        kind: Kind::Real {
+            unit: "rad/s",
+            min: Limit::AtLeast(0.0),
+            max: Limit::Below(std::f64::consts::PI),
+            get: |t| t.tracking.course_rate,
+            set: |t, v| t.tracking.course_rate = v,
+        },
+    },
+    Parameter {
+        name: "tracking.course_lead",
+        old_name: None,
+        description: "Largest angle between the reference course and the ship's heading: the tracked point leads a turn the ship is making but never lies abeam of her (seamanship: drift angle under 30 deg); 20 deg (docs/assumptions.md); 0: no limit",
+        kind: Kind::Real {
+            unit: "rad",
+            min: Limit::AtLeast(0.0),
+            max: Limit::Below(std::f64::consts::PI),
+            get: |t| t.tracking.course_lead,
+            set: |t, v| t.tracking.course_lead = v,
         },
     },
 ];

@@ -308,6 +308,79 @@ fn a_failed_solve_applies_the_shifted_plan_within_bounds_then_comes_to_rest() {
 /// heading at the start of the encounter, less the margin, becomes a floor; it
 /// ratchets up with the heading, lifts when the situation ends, and scheme III
 /// has none.
+/// A measurement that describes no tow (every input 0, as a controller run alone sees):
+/// no solve and no fallback, the rest command, every value of the report finite; the
+/// first such sample is marked to report, the next not; a tow again solves.
+#[test]
+fn a_measurement_with_vessels_inside_each_other_rests_without_fallback() {
+    let (scenario, m) = paper_measurement();
+    let config = ControllerConfig::new(scenario);
+    let mut c = Controller::new(config.clone()).unwrap();
+    let zero = Measurement::default();
+    for k in 0..3 {
+        let r = c.sample(&zero).unwrap();
+        assert!(r.fallback.is_none(), "{:?}", r.fallback);
+        let rest = r.rest.expect("vessels inside each other rest");
+        assert_eq!(rest.first, k == 0);
+        assert_eq!(rest.overlap.vessels, ["ship", "tug1"]);
+        assert_eq!(rest.overlap.distance, 0.0);
+        assert_eq!(r.iterations, 0);
+        assert_eq!(r.command.tug_thrust, [[0.0; 3]; 2]);
+        let f0 = config.tuning.ship.min_tension;
+        assert_eq!(r.command.tension, [f0, f0]);
+        assert_eq!(r.desired_angle, [0.0, 0.0]);
+        let p = &r.prediction;
+        assert!(p
+            .ship
+            .iter()
+            .chain(p.tugs.iter().flatten())
+            .flatten()
+            .all(|v| v.is_finite()));
+        assert!(r.r_pri.iter().chain(&r.r_dual).all(|v| v.is_finite()));
+    }
+    // Tug 2 inside the ship's hull (closer than half its beam) is no tow either.
+    let mut inside = m;
+    inside.tugs[1][0] = m.ship[0] + 0.1;
+    inside.tugs[1][1] = m.ship[1];
+    let r = c.sample(&inside).unwrap();
+    assert_eq!(r.rest.unwrap().overlap.vessels, ["ship", "tug2"]);
+    let r = c.sample(&m).unwrap();
+    assert!(r.rest.is_none() && r.fallback.is_none());
+    assert!(r.iterations >= 1);
+    assert_eq!(c.fallbacks(), 0);
+}
+
+/// Speeds far beyond the model's range make the MPC's iterates overflow: the sample
+/// falls back, and every value of its report stays finite.
+#[test]
+fn absurd_speeds_fall_back_with_a_finite_report() {
+    let (scenario, m) = paper_measurement();
+    let config = ControllerConfig::new(scenario);
+    for speed in [10.0, 100.0, 1000.0] {
+        let mut c = Controller::new(config.clone()).unwrap();
+        let mut fast = m;
+        for s in std::iter::once(&mut fast.ship).chain(fast.tugs.iter_mut()) {
+            s[3] = speed;
+            s[4] = -0.5 * speed;
+        }
+        for _ in 0..3 {
+            let r = c.sample(&fast).unwrap();
+            let p = &r.prediction;
+            let values = p.ship.iter().chain(p.tugs.iter().flatten()).flatten();
+            assert!(values.clone().all(|v| v.is_finite()), "{speed} m/s: {p:?}");
+            assert!(
+                r.r_pri.iter().chain(&r.r_dual).all(|v| v.is_finite()),
+                "{speed} m/s: {:?} {:?}",
+                r.r_pri,
+                r.r_dual
+            );
+            assert!(r.reference.iter().all(|v| v.is_finite()));
+            assert!(r.desired_angle.iter().all(|v| v.is_finite()));
+            assert_within_bounds(&r.command, &config);
+        }
+    }
+}
+
 #[test]
 fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
     let (scenario, mut m) = paper_measurement();

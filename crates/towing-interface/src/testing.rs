@@ -35,6 +35,19 @@ pub fn instantiate(exports: Exports, description: &ModelDescription, name: &str)
         .unwrap_or_else(|log| panic!("instantiate failed: {log:?}"))
 }
 
+/// Every Real output's value reference, in model-description order.
+#[must_use]
+pub fn real_outputs(description: &ModelDescription) -> Vec<u32> {
+    description
+        .variables
+        .iter()
+        .filter(|v| {
+            v.causality == fmi2_slave::Causality::Output && v.value_type() == ValueType::Real
+        })
+        .map(|v| v.value_reference)
+        .collect()
+}
+
 /// The last message `fmu` logged contains `needle` (all messages are shown when not).
 pub fn assert_last_message_contains(fmu: &Fmu, needle: &str) {
     assert!(

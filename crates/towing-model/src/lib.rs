@@ -73,7 +73,7 @@ pub use scenario::{Route, Scenario, ScenarioError, ScenarioErrorKind, TugPlaceme
 pub use state::{Pose, VesselState};
 pub use towline::{ElasticTowlineParams, TowlineModel, TowlineOutput};
 pub use traffic::{ObstacleKind, ObstacleShape, ObstacleSlot, TrafficObstacle};
-pub use vessel::{Damping, ParamError, TitoNeriDampingSet, VesselData};
+pub use vessel::{Damping, ParamError, TitoNeriDampingSet, VesselData, MAX_DISTANCE, MAX_SPEED};
 pub use world::{StepError, World, WorldError, WorldInputs};
 
 /// Number of obstacle output slots of the world (and of the plant FMU's

@@ -23,7 +23,8 @@ use crate::state::VesselState;
 use crate::towline::{formation_pose, ElasticTowlineParams, TowlineModel};
 use crate::traffic::{ObstacleShape, TrafficObstacle};
 use crate::vessel::{
-    check_finite, check_positive, Damping, ParamError, TitoNeriDampingSet, VesselData,
+    check_coordinate, check_finite, check_length, check_speed, Damping, ParamError,
+    TitoNeriDampingSet, VesselData,
 };
 use crate::MAX_OBSTACLES;
 
@@ -283,7 +284,7 @@ impl Scenario {
             .map_err(|e| e.within("simulation.elastic_towline"))?;
         check_state("ship", &self.ship)?;
         for (i, length) in self.towline_desired_length.iter().enumerate() {
-            check_positive(&format!("towline{}.desired_length", i + 1), *length, "m")?;
+            check_length(&format!("towline{}.desired_length", i + 1), *length)?;
         }
         for (i, (state, placement)) in self.tugs.iter().zip(&self.tug_placement).enumerate() {
             let tug = format!("tug{}", i + 1);
@@ -329,7 +330,7 @@ impl Scenario {
             }
         }
         if let Some(w) = &self.waterway {
-            check_positive("waterway.half_width", w.half_width, "m")?;
+            check_length("waterway.half_width", w.half_width)?;
         }
         if self.obstacles.len() > MAX_OBSTACLES {
             return Err(ParamError::new(
@@ -354,17 +355,22 @@ impl Scenario {
     }
 }
 
+/// A vessel's state: finite, its position within [`crate::vessel::MAX_DISTANCE`] and its
+/// speeds within [`crate::vessel::MAX_SPEED`].
 fn check_state(prefix: &str, s: &VesselState) -> Result<(), ParamError> {
     let names = ["x", "y", "psi_deg", "u", "v", "r_deg_s"];
     for (name, value) in names.iter().zip(s.eta.iter().chain(s.nu.iter())) {
         check_finite(&format!("{prefix}.{name}"), *value)?;
     }
-    Ok(())
+    check_coordinate(&format!("{prefix}.x"), s.eta[0])?;
+    check_coordinate(&format!("{prefix}.y"), s.eta[1])?;
+    check_speed(&format!("{prefix}.u"), s.nu[0])?;
+    check_speed(&format!("{prefix}.v"), s.nu[1])
 }
 
 fn check_pose(prefix: &str, p: &Pose) -> Result<(), ParamError> {
-    check_finite(&format!("{prefix}.x"), p.x)?;
-    check_finite(&format!("{prefix}.y"), p.y)?;
+    check_coordinate(&format!("{prefix}.x"), p.x)?;
+    check_coordinate(&format!("{prefix}.y"), p.y)?;
     check_finite(&format!("{prefix}.psi_deg"), p.psi)
 }
 

@@ -214,14 +214,16 @@ impl TrafficObstacle {
     /// finite, speed >= 0, activation time finite and >= 0 (or `+inf` together
     /// with an activation range), activation range finite and > 0.
     pub fn validate(&self) -> Result<(), ParamError> {
-        use crate::vessel::{check_finite, check_non_negative, check_positive};
+        use crate::vessel::{
+            check_coordinate, check_finite, check_length, check_non_negative, check_speed,
+        };
         if self.name.trim().is_empty() {
             return Err(ParamError::new("name", "must not be empty"));
         }
-        check_finite("x", self.x)?;
-        check_finite("y", self.y)?;
+        check_coordinate("x", self.x)?;
+        check_coordinate("y", self.y)?;
         match self.shape {
-            ObstacleShape::Circle { diameter } => check_positive("diameter", diameter, "m")?,
+            ObstacleShape::Circle { diameter } => check_length("diameter", diameter)?,
             ObstacleShape::Vessel {
                 length,
                 width,
@@ -230,8 +232,8 @@ impl TrafficObstacle {
                 activation_time,
                 activation_range,
             } => {
-                check_positive("length", length, "m")?;
-                check_positive("width", width, "m")?;
+                check_length("length", length)?;
+                check_length("width", width)?;
                 if width > length {
                     return Err(ParamError::new(
                         "width",
@@ -242,8 +244,9 @@ impl TrafficObstacle {
                 }
                 check_finite("course_deg", course)?;
                 check_non_negative("speed", speed, "m/s")?;
+                check_speed("speed", speed)?;
                 if let Some(range) = activation_range {
-                    check_positive("activation_range", range, "m")?;
+                    check_length("activation_range", range)?;
                 }
                 // +inf is "never by time": allowed only when the range triggers it.
                 if !(activation_time == f64::INFINITY && activation_range.is_some()) {

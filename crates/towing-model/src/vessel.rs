@@ -75,6 +75,58 @@ pub(crate) fn check_positive(field: &str, value: f64, unit: &str) -> Result<(), 
     }
 }
 
+/// The largest coordinate or length a scenario may give (m): 1e8 m, more than twice the
+/// Earth's circumference, so every real chart fits (UTM northings reach 1e7 m), while the
+/// model's geometry stays well within `f64`: squared distances below 1e17 m^2, and a
+/// position's resolution (1.5e-8 m at 1e8 m) far below the millimetres a vessel moves in one
+/// integration step. Beyond it a scenario is refused: `desired_length = 1.8e308` placed a tug
+/// where the towline's length overflowed to infinity.
+pub const MAX_DISTANCE: f64 = 1e8;
+
+/// The largest speed a scenario may give (m/s): far above any vessel's, and small enough
+/// that a target ship's track stays within `f64` for any simulated time.
+pub const MAX_SPEED: f64 = 1e3;
+
+/// A coordinate: finite and within [`MAX_DISTANCE`] of the origin.
+pub(crate) fn check_coordinate(field: &str, value: f64) -> Result<(), ParamError> {
+    check_finite(field, value)?;
+    check_at_most(field, value.abs(), value, MAX_DISTANCE, "m", "MAX_DISTANCE")
+}
+
+/// A length: positive and at most [`MAX_DISTANCE`].
+pub(crate) fn check_length(field: &str, value: f64) -> Result<(), ParamError> {
+    check_positive(field, value, "m")?;
+    check_at_most(field, value, value, MAX_DISTANCE, "m", "MAX_DISTANCE")
+}
+
+/// A speed: finite and at most [`MAX_SPEED`] in magnitude.
+pub(crate) fn check_speed(field: &str, value: f64) -> Result<(), ParamError> {
+    check_finite(field, value)?;
+    check_at_most(field, value.abs(), value, MAX_SPEED, "m/s", "MAX_SPEED")
+}
+
+fn check_at_most(
+    field: &str,
+    magnitude: f64,
+    value: f64,
+    limit: f64,
+    unit: &str,
+    name: &str,
+) -> Result<(), ParamError> {
+    if magnitude <= limit {
+        Ok(())
+    } else {
+        Err(ParamError::new(
+            field,
+            format!(
+                "must be at most {limit:e} {unit} in magnitude ({name}: beyond any physical size, \
+                 the geometry derived from it would overflow or lose the model's resolution), \
+                 got {value:e} {unit}"
+            ),
+        ))
+    }
+}
+
 pub(crate) fn check_non_negative(field: &str, value: f64, unit: &str) -> Result<(), ParamError> {
     check_finite(field, value)?;
     if value >= 0.0 {
@@ -495,8 +547,10 @@ impl VesselData {
         for (name, value) in self.scalar_fields() {
             check_finite(name, value)?;
         }
-        check_positive("length", self.length, "m")?;
-        check_positive("width", self.width, "m")?;
+        check_length("length", self.length)?;
+        check_length("width", self.width)?;
+        check_coordinate("stern_tow_point_x", self.stern_tow_point_x)?;
+        check_coordinate("bow_tow_point_x", self.bow_tow_point_x)?;
         check_positive("mass", self.mass, "kg")?;
         check_positive("inertia_z", self.inertia_z, "kg m^2")?;
         check_non_negative("max_surge_force", self.max_surge_force, "N")?;

@@ -519,20 +519,53 @@ impl World {
             }
         }
         let time = self.time + h;
-        // Commit.
+        // Commit, unless a towline's geometry or tension overflows (states far
+        // apart but finite): the outputs must be finite too.
+        let before = (self.vessels, self.l0);
         self.unpack(&x);
+        let tension = match self.line_tensions(&cmd) {
+            Ok(tension) => tension,
+            Err(e) => {
+                (self.vessels, self.l0) = before;
+                return Err(e);
+            }
+        };
         self.time = time;
+        self.tension = tension;
+        self.slack = tension.map(|t| t <= 0.0);
+        self.update_activations();
+        Ok(())
+    }
+
+    /// Each towline's tension for the commands `cmd` in the current geometry;
+    /// an error naming the line when its length, length rate, angle or
+    /// tension is not finite.
+    fn line_tensions(&self, cmd: &[f64; 2]) -> Result<[f64; 2], StepError> {
+        let mut tension = [0.0; 2];
         for (line, &command) in cmd.iter().enumerate() {
             let g = self.line_geometry(line);
             let t = match &self.elastic {
                 None => ideal_winch_tension(command, g.length),
                 Some(p) => elastic_tension(p, g.length, g.length_rate, self.l0[line]),
             };
-            self.tension[line] = t;
-            self.slack[line] = t <= 0.0;
+            let angle =
+                towline::towing_angle(line, g.ship_point, g.tug_point, self.vessels[0].eta[2]);
+            if let Some((name, value)) = [
+                ("length", g.length),
+                ("length rate", g.length_rate),
+                ("angle", angle),
+                ("tension", t),
+            ]
+            .into_iter()
+            .find(|(_, v)| !v.is_finite())
+            {
+                return Err(StepError::NonFinite {
+                    what: format!("towline{} {name} = {value} after integration", line + 1),
+                });
+            }
+            tension[line] = t;
         }
-        self.update_activations();
-        Ok(())
+        Ok(tension)
     }
 
     fn pack(&self) -> StateVec {

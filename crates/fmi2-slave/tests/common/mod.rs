@@ -43,6 +43,8 @@ pub const FAULT_ERROR: i32 = 3;
 pub const FAULT_PANIC: i32 = 4;
 /// Fault mode whose getter of `steps` refuses (a model error of a getter).
 pub const FAULT_GET: i32 = 5;
+/// Fault mode whose getter of the output `y` returns NaN (a model bug the layer catches).
+pub const FAULT_NAN: i32 = 6;
 
 pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(|| {
     let mut log_categories = LogCategory::standard();
@@ -104,7 +106,7 @@ pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(|| {
                 "fault_mode",
                 I_FAULT,
                 0,
-                "0 ok, 1 warning, 2 discard, 3 error, 4 panic",
+                "0 ok, 1 warning, 2 discard, 3 error, 4 panic, 5 getter of steps fails, 6 y reads NaN",
             ),
             Variable {
                 name: "version".into(),
@@ -222,6 +224,7 @@ impl<const BROKEN: bool> Fmi2Model for LagModel<BROKEN> {
     fn get_real(&self, vr: u32) -> Result<f64, String> {
         Ok(match vr {
             R_U => self.u,
+            R_Y if self.fault_mode == FAULT_NAN => f64::NAN,
             R_Y => self.y,
             R_T => self.t_const,
             R_Y0 => self.y0,

@@ -697,6 +697,89 @@ fn refuses_non_positive_sizes_and_lengths() {
     );
 }
 
+/// Lengths, coordinates and speeds beyond any physical size are refused by name: the
+/// geometry derived from them overflows (`desired_length = 1.7976931348623157e308` gave a
+/// towline of infinite length with fmi2OK).
+#[test]
+fn refuses_lengths_coordinates_and_speeds_beyond_any_physical_size() {
+    let why = "must be at most 1e8 m in magnitude (MAX_DISTANCE";
+    let text = MINIMAL.replace(
+        "desired_length = 1.0\n\n[route]",
+        "desired_length = 1.7976931348623157e308\n\n[route]",
+    );
+    let e = refused(
+        &text,
+        ScenarioErrorKind::Invalid,
+        "towline2.desired_length",
+        why,
+    );
+    assert!(
+        e.reason.ends_with("got 1.7976931348623157e308 m"),
+        "{}",
+        e.reason
+    );
+    let text = MINIMAL.replacen("x = 0.0\ny = 0.0", "x = 0.0\ny = -2e8", 1);
+    refused(&text, ScenarioErrorKind::Invalid, "ship.y", why);
+    let text = MINIMAL.replace("destination = { x = 20.0", "destination = { x = 1e300");
+    refused(
+        &text,
+        ScenarioErrorKind::Invalid,
+        "route.destination.x",
+        why,
+    );
+    let text = format!("{MINIMAL}{}", TARGET.replace("x = 5.0", "x = 1e9"));
+    refused(&text, ScenarioErrorKind::Invalid, "obstacles[0].x", why);
+    let text = format!(
+        "{MINIMAL}{}",
+        TARGET.replace("length = 1.48", "length = 1e9")
+    );
+    refused(
+        &text,
+        ScenarioErrorKind::Invalid,
+        "obstacles[0].length",
+        why,
+    );
+    let text = format!("{MINIMAL}[waterway]\nhalf_width = 1e300\n");
+    refused(
+        &text,
+        ScenarioErrorKind::Invalid,
+        "waterway.half_width",
+        why,
+    );
+    let text = format!("{MINIMAL}[vessels.ship]\nlength = 1e9\n");
+    refused(
+        &text,
+        ScenarioErrorKind::Invalid,
+        "vessels.ship.length",
+        why,
+    );
+    let speed = "must be at most 1e3 m/s in magnitude (MAX_SPEED";
+    let text = format!(
+        "{MINIMAL}{}",
+        TARGET.replace("speed = 0.07", "speed = 1e300")
+    );
+    refused(
+        &text,
+        ScenarioErrorKind::Invalid,
+        "obstacles[0].speed",
+        speed,
+    );
+    let text = MINIMAL.replacen(
+        "x = 0.0\ny = 0.0\npsi_deg = 0.0",
+        "x = 0.0\ny = 0.0\npsi_deg = 0.0\nu = 2e3",
+        1,
+    );
+    refused(&text, ScenarioErrorKind::Invalid, "ship.u", speed);
+    // At the limits: accepted.
+    let text = MINIMAL
+        .replace(
+            "desired_length = 1.0\n\n[route]",
+            "desired_length = 1e3\n\n[route]",
+        )
+        .replace("destination = { x = 20.0", "destination = { x = 1e8");
+    parse(&text).unwrap();
+}
+
 #[test]
 fn refuses_non_physical_vessel_data() {
     let text = format!("{MINIMAL}[vessels.ship]\nmass = 0.0\n");
