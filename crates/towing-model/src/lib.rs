@@ -19,6 +19,8 @@
 //! - [`state`]: a pose ([`Pose`]) and a vessel's pose and velocity ([`VesselState`]);
 //!   [`config`]: the physics configuration ([`WorldConfig`]). The scenario and the world
 //!   both use them; the world reads the scenario, never the other way round.
+//! - [`geometry`]: the hull footprint ([`HullRect`]) and the waterway ([`Lane`]: the
+//!   route with its half width), shared by the plant, the MPC and the analyzer.
 //! - [`world`]: the three vessels and two towlines integrated jointly with RK4
 //!   ([`World`]), atomic steps, state serialisation.
 //! - [`scenario`]: the TOML scenario format ([`Scenario`], `docs/scenario-format.md`);
@@ -57,6 +59,7 @@
 
 pub mod angle;
 pub mod config;
+pub mod geometry;
 pub mod kinetics;
 pub mod registry;
 pub mod scenario;
@@ -68,6 +71,7 @@ pub mod world;
 
 pub use angle::wrap_angle;
 pub use config::WorldConfig;
+pub use geometry::{HullRect, Lane, Polyline};
 pub use kinetics::{HullDynamics, HullModel, LinearDampingHull, NonlinearDampingHull};
 pub use scenario::{Route, Scenario, ScenarioError, ScenarioErrorKind, TugPlacement, Waterway};
 pub use state::{Pose, VesselState};

@@ -42,6 +42,7 @@ use nalgebra::{Matrix3, Vector3};
 use thiserror::Error;
 
 use crate::angle::wrap_angle;
+use crate::geometry::{HullRect, Lane};
 use crate::kinetics::{HullDynamics, HullModel};
 use crate::scenario::{Scenario, ScenarioError};
 use crate::towline::{
@@ -149,6 +150,8 @@ pub struct World {
     winch_max: [f64; 2],
     tau_max: [[f64; 3]; 2],
     obstacles: Vec<TrafficObstacle>,
+    /// The scenario's waterway (the bank the hulls are judged against).
+    lane: Option<Lane>,
     fingerprint: u64,
     // Dynamic state.
     time: f64,
@@ -240,6 +243,7 @@ impl World {
             winch_max: [data[1].winch_max_tension, data[2].winch_max_tension],
             tau_max: [tau_of(&data[1]), tau_of(&data[2])],
             obstacles: scenario.obstacles.clone(),
+            lane: Lane::of_scenario(scenario),
             fingerprint: 0,
             time: 0.0,
             vessels,
@@ -318,6 +322,26 @@ impl World {
     #[must_use]
     pub fn config(&self) -> &WorldConfig {
         &self.config
+    }
+
+    /// The scenario's waterway, if it has one.
+    #[must_use]
+    pub fn lane(&self) -> Option<&Lane> {
+        self.lane.as_ref()
+    }
+
+    /// How far each hull (ship, tug 1, tug 2) reaches beyond the bank of the
+    /// scenario's waterway now ([`Lane::hull_excess`] of its footprint, the
+    /// [`HullRect`] of its length and beam; positive: aground by that much, m);
+    /// `None` without a waterway. The world has no physics of grounding: a hull
+    /// beyond the bank keeps moving as in open water (`docs/assumptions.md`).
+    #[must_use]
+    pub fn bank_excess(&self) -> Option<[f64; 3]> {
+        let lane = self.lane.as_ref()?;
+        Some(std::array::from_fn(|k| {
+            let [x, y, psi] = self.vessels[k].eta;
+            lane.hull_excess(&HullRect::of(&self.data[k]), x, y, psi)
+        }))
     }
 
     /// The ship's state.

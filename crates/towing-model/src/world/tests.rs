@@ -1289,3 +1289,40 @@ fn paper_targets_b_and_c_wait_for_the_tow() {
     let w = World::new(&s, WorldConfig::default()).unwrap();
     assert_eq!(w.activation_time(5), Some(0.0));
 }
+
+/// The bank: no waterway, no judgement. In a 0.1 m half width, with the tow in the middle
+/// of the route heading along it, each hull pokes out by its half beam less 0.1 m (the
+/// ship 0.045 m, the tugs 0.05 m); moved 0.1 m to port, by its half beam. At the route's
+/// start the lane ends in a half circle round the origin: the ship's stern corners there
+/// are half its diagonal from it. The hulls keep moving.
+#[test]
+fn bank_excess_measures_the_footprints() {
+    let open = World::new(&scenario(BASE), WorldConfig::default()).unwrap();
+    assert!(open.lane().is_none() && open.bank_excess().is_none());
+    let narrow = format!("{BASE}\n[waterway]\nhalf_width = 0.1\n");
+    let mut s = scenario(&narrow);
+    let at_start = World::new(&s, WorldConfig::default()).unwrap();
+    let d = at_start.data[0];
+    let diagonal = (d.length / 2.0).hypot(d.width / 2.0);
+    assert!((at_start.bank_excess().unwrap()[0] - (diagonal - 0.1)).abs() < 1e-12);
+    s.ship.eta[0] = 10.0;
+    s.place_tugs();
+    let world = World::new(&s, WorldConfig::default()).unwrap();
+    let e = world.bank_excess().unwrap();
+    let half_beam = [0, 1, 2].map(|k| world.data[k].width / 2.0);
+    for k in 0..3 {
+        assert!((e[k] - (half_beam[k] - 0.1)).abs() < 1e-12, "{k}: {e:?}");
+    }
+    s.ship.eta[1] = -0.1;
+    s.place_tugs();
+    let world = World::new(&s, WorldConfig::default()).unwrap();
+    let e = world.bank_excess().unwrap();
+    assert!((e[0] - half_beam[0]).abs() < 1e-12, "{e:?}");
+    let wide = format!("{BASE}\n[waterway]\nhalf_width = 5.0\n");
+    let world = World::new(&scenario(&wide), WorldConfig::default()).unwrap();
+    assert!(
+        world.bank_excess().unwrap().iter().all(|&e| e < -2.0),
+        "{:?}",
+        world.bank_excess()
+    );
+}

@@ -1,0 +1,396 @@
+//! Plane geometry shared by the plant, the MPC and the analyzer: a hull's footprint
+//! ([`HullRect`]), the route as a polyline ([`Polyline`]) and the waterway around it
+//! ([`Lane`]: the route plus its half width, the bank on either side).
+//!
+//! Points are `[north, east]` in m, headings from North, clockwise (NED, Fossen 2021,
+//! section 2.2; `paper/NOTES.md` section 1: a body's forward unit vector is
+//! `(cos psi, sin psi)`, its starboard unit vector `(-sin psi, cos psi)`).
+//!
+//! The waterway is the set of points within `half_width` of the route polyline (the
+//! distance to the nearest point of any segment, so the lane has round ends and round
+//! outer corners): the paper's `d_2` (Du et al. 2022, section 3.1, `theta_max =
+//! arctan(d_2 / d_1)`) read as a bank on either side of the route. A hull is beyond the
+//! bank when a corner of its footprint is ([`Lane::hull_excess`]).
+
+use serde::{Deserialize, Serialize};
+
+use crate::scenario::{Route, Scenario};
+
+/// A point `[north, east]`, m.
+pub type Point = [f64; 2];
+
+/// Euclidean distance.
+#[must_use]
+pub fn dist(a: Point, b: Point) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// Body point `(bx forward, by starboard)` of a vessel at `(x, y, psi)`, in NED
+/// (the rotation `R(psi)` of Fossen 2021, eq. (2.18), in the plane).
+#[must_use]
+pub fn body_to_ned(x: f64, y: f64, psi: f64, bx: f64, by: f64) -> Point {
+    let (s, c) = psi.sin_cos();
+    [x + bx * c - by * s, y + bx * s + by * c]
+}
+
+/// A hull's footprint: a rectangle `length` x `width` centred at the body origin (the
+/// position the state gives) and aligned with the heading. The vessels' data give
+/// length and beam ([`crate::VesselData`]); the rectangle is the footprint every
+/// judgement of contact uses (hull overlaps, groundings).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HullRect {
+    /// Length overall (m).
+    pub length: f64,
+    /// Beam (m).
+    pub width: f64,
+}
+
+impl HullRect {
+    /// The footprint of a `length` x `width` hull.
+    #[must_use]
+    pub fn new(length: f64, width: f64) -> HullRect {
+        HullRect { length, width }
+    }
+
+    /// The footprint of a vessel's data.
+    #[must_use]
+    pub fn of(data: &crate::VesselData) -> HullRect {
+        HullRect::new(data.length, data.width)
+    }
+
+    /// The corners at the pose `(x, y, psi)`, in order bow-starboard, bow-port,
+    /// stern-port, stern-starboard.
+    #[must_use]
+    pub fn corners(&self, x: f64, y: f64, psi: f64) -> [Point; 4] {
+        let (a, b) = (self.length / 2.0, self.width / 2.0);
+        [
+            body_to_ned(x, y, psi, a, b),
+            body_to_ned(x, y, psi, a, -b),
+            body_to_ned(x, y, psi, -a, -b),
+            body_to_ned(x, y, psi, -a, b),
+        ]
+    }
+
+    /// The footprint's radius about the body origin (the corners' distance,
+    /// `hypot(L/2, B/2)`): every point of the hull is within it of the position, at
+    /// any heading.
+    #[must_use]
+    pub fn radius(&self) -> f64 {
+        (self.length / 2.0).hypot(self.width / 2.0)
+    }
+}
+
+/// The fraction along `a`-`b` (in `[0, 1]`) of the point of the segment nearest to `p`,
+/// and the distance to it. A zero-length segment is its point.
+#[must_use]
+pub fn segment_projection(p: Point, a: Point, b: Point) -> (f64, f64) {
+    let ab = [b[0] - a[0], b[1] - a[1]];
+    let len2 = ab[0] * ab[0] + ab[1] * ab[1];
+    let f = if len2 > 0.0 {
+        (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let q = [a[0] + f * ab[0], a[1] + f * ab[1]];
+    (f, dist(p, q))
+}
+
+/// A point's nearest point on a [`Polyline`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Projection {
+    /// Arc length of the nearest point from the polyline's start, m.
+    pub s: f64,
+    /// Distance from the polyline, m.
+    pub distance: f64,
+    /// The nearest segment (points `segment`, `segment + 1`; 0 for a one-point
+    /// polyline).
+    pub segment: usize,
+    /// The nearest point.
+    pub point: Point,
+}
+
+/// The route as a polyline through its points (origin, waypoints, destination), with
+/// the arc length at each point.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(from = "Vec<Point>", into = "Vec<Point>")]
+pub struct Polyline {
+    points: Vec<Point>,
+    /// Arc length at each point, m (`cum[0] = 0`).
+    cum: Vec<f64>,
+}
+
+impl From<Vec<Point>> for Polyline {
+    fn from(points: Vec<Point>) -> Polyline {
+        let mut cum = Vec::with_capacity(points.len());
+        let mut total = 0.0;
+        for (k, p) in points.iter().enumerate() {
+            if k > 0 {
+                total += dist(points[k - 1], *p);
+            }
+            cum.push(total);
+        }
+        Polyline { points, cum }
+    }
+}
+
+impl From<Polyline> for Vec<Point> {
+    fn from(p: Polyline) -> Vec<Point> {
+        p.points
+    }
+}
+
+impl Polyline {
+    /// The polyline through `points`; `None` without a point.
+    #[must_use]
+    pub fn new(points: Vec<Point>) -> Option<Polyline> {
+        (!points.is_empty()).then(|| Polyline::from(points))
+    }
+
+    /// The polyline through the positions of route points `[north, east, heading]`;
+    /// `None` without a point.
+    #[must_use]
+    pub fn from_route(route: &[[f64; 3]]) -> Option<Polyline> {
+        Polyline::new(route.iter().map(|p| [p[0], p[1]]).collect())
+    }
+
+    /// The polyline of a scenario's route.
+    #[must_use]
+    pub fn of_route(route: &Route) -> Polyline {
+        Polyline::from(route.points().map(|p| [p.x, p.y]).collect::<Vec<_>>())
+    }
+
+    /// The points.
+    #[must_use]
+    pub fn points(&self) -> &[Point] {
+        &self.points
+    }
+
+    /// Total length, m.
+    #[must_use]
+    pub fn length(&self) -> f64 {
+        self.cum.last().copied().unwrap_or(0.0)
+    }
+
+    /// The last point (the destination).
+    #[must_use]
+    pub fn end(&self) -> Point {
+        self.points[self.points.len() - 1]
+    }
+
+    /// The nearest point of any segment to `p` (the first segment on a tie). A
+    /// one-point polyline projects every point onto that point (`s = 0`).
+    #[must_use]
+    pub fn project(&self, p: Point) -> Projection {
+        let mut best = Projection {
+            s: 0.0,
+            distance: dist(p, self.points[0]),
+            segment: 0,
+            point: self.points[0],
+        };
+        for (k, w) in self.points.windows(2).enumerate() {
+            let (f, d) = segment_projection(p, w[0], w[1]);
+            if d < best.distance {
+                best = Projection {
+                    s: self.cum[k] + f * (self.cum[k + 1] - self.cum[k]),
+                    distance: d,
+                    segment: k,
+                    point: [
+                        w[0][0] + f * (w[1][0] - w[0][0]),
+                        w[0][1] + f * (w[1][1] - w[0][1]),
+                    ],
+                };
+            }
+        }
+        best
+    }
+
+    /// Distance of `p` from the polyline (nearest point of any segment), m.
+    #[must_use]
+    pub fn distance(&self, p: Point) -> f64 {
+        self.project(p).distance
+    }
+
+    /// The unit starboard normal of segment `k` (`(-sin chi, cos chi)` for the
+    /// segment's course `chi`); `[0, 1]` for a zero-length segment or a one-point
+    /// polyline.
+    #[must_use]
+    pub fn starboard_normal(&self, k: usize) -> Point {
+        match (self.points.get(k), self.points.get(k + 1)) {
+            (Some(a), Some(b)) => {
+                let (dn, de) = (b[0] - a[0], b[1] - a[1]);
+                let l = dn.hypot(de);
+                if l > 0.0 {
+                    [-de / l, dn / l]
+                } else {
+                    [0.0, 1.0]
+                }
+            }
+            _ => [0.0, 1.0],
+        }
+    }
+}
+
+/// The waterway: the route polyline and its half width (module docs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Lane {
+    /// The route.
+    pub centre: Polyline,
+    /// Distance from the route to the bank on either side, m (> 0).
+    pub half_width: f64,
+}
+
+impl Lane {
+    /// The lane of `centre` with `half_width`.
+    #[must_use]
+    pub fn new(centre: Polyline, half_width: f64) -> Lane {
+        Lane { centre, half_width }
+    }
+
+    /// The scenario's waterway around its route; `None` without a `[waterway]`.
+    #[must_use]
+    pub fn of_scenario(scenario: &Scenario) -> Option<Lane> {
+        scenario
+            .waterway
+            .map(|w| Lane::new(Polyline::of_route(&scenario.route), w.half_width))
+    }
+
+    /// How far `p` is beyond the bank (its distance from the route less the half
+    /// width; negative inside), m.
+    #[must_use]
+    pub fn excess(&self, p: Point) -> f64 {
+        self.centre.distance(p) - self.half_width
+    }
+
+    /// How far the hull `hull` at `(x, y, psi)` reaches beyond the bank: the largest
+    /// [`Lane::excess`] of its corners (negative: the whole footprint inside by that
+    /// much). The lane is the set within `half_width` of a polyline; a rectangle with
+    /// every corner inside can still poke its side out only at an inner bend sharper
+    /// than the hull is long, which the routes here (legs of several ship lengths,
+    /// turns under 90 deg) do not have.
+    #[must_use]
+    pub fn hull_excess(&self, hull: &HullRect, x: f64, y: f64, psi: f64) -> f64 {
+        hull.corners(x, y, psi)
+            .iter()
+            .map(|&c| self.excess(c))
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// The distance `d` of `p` from the route and its gradient `dd/dp`: the unit vector
+    /// from the nearest point of the route to `p`. Inside a segment's span that is
+    /// `+-` the segment's starboard normal and `d` the absolute lateral offset from
+    /// it; beyond a segment's end, the direction from its end point. On the route
+    /// itself (`d` below 1e-9 m) the gradient is the nearest segment's starboard
+    /// normal (a one-sided derivative; the distance is not differentiable there).
+    #[must_use]
+    pub fn distance_and_gradient(&self, p: Point) -> (f64, Point) {
+        let q = self.centre.project(p);
+        let grad = if q.distance > 1e-9 {
+            [
+                (p[0] - q.point[0]) / q.distance,
+                (p[1] - q.point[1]) / q.distance,
+            ]
+        } else {
+            self.centre.starboard_normal(q.segment)
+        };
+        (q.distance, grad)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    fn l_lane() -> Lane {
+        Lane::new(
+            Polyline::new(vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]]).unwrap(),
+            2.0,
+        )
+    }
+
+    #[test]
+    fn hull_corners_follow_heading() {
+        // Heading East: the bow is East of the centre, starboard is South.
+        let h = HullRect::new(2.0, 1.0).corners(0.0, 0.0, PI / 2.0);
+        assert!((h[0][1] - 1.0).abs() < 1e-12 && (h[0][0] + 0.5).abs() < 1e-12);
+        assert!((HullRect::new(2.0, 1.0).radius() - 1.25f64.sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn projection_on_an_l_shaped_route() {
+        let p = l_lane().centre;
+        assert_eq!(p.length(), 20.0);
+        let q = p.project([5.0, -2.0]);
+        assert!((q.s - 5.0).abs() < 1e-12 && (q.distance - 2.0).abs() < 1e-12);
+        assert_eq!((q.segment, q.point), (0, [5.0, 0.0]));
+        let q = p.project([12.0, 4.0]);
+        assert!((q.s - 14.0).abs() < 1e-12 && (q.distance - 2.0).abs() < 1e-12);
+        assert_eq!(q.segment, 1);
+        assert!((p.distance([-3.0, 4.0]) - 5.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn excess_and_hull_excess() {
+        let lane = l_lane();
+        assert!((lane.excess([5.0, 1.5]) + 0.5).abs() < 1e-12);
+        assert!((lane.excess([5.0, -3.0]) - 1.0).abs() < 1e-12);
+        // A 2 x 1 hull heading North 1.2 m to port of the first leg: its port corners
+        // are 1.7 m off, inside; 1.8 m off, its port side is 0.3 m beyond the bank.
+        let hull = HullRect::new(2.0, 1.0);
+        assert!((lane.hull_excess(&hull, 5.0, -1.2, 0.0) + 0.3).abs() < 1e-12);
+        assert!((lane.hull_excess(&hull, 5.0, -2.3, 0.0) - 0.8).abs() < 1e-12);
+        // Turned across the lane, the bow reaches further.
+        assert!(lane.hull_excess(&hull, 5.0, -1.2, -PI / 2.0) > 0.0);
+    }
+
+    #[test]
+    fn gradient_is_the_outward_unit_vector() {
+        let lane = l_lane();
+        // Port of the first leg (heading North): the starboard normal is East, so
+        // outward to port is West.
+        let (d, g) = lane.distance_and_gradient([5.0, -1.0]);
+        assert!((d - 1.0).abs() < 1e-12 && (g[1] + 1.0).abs() < 1e-12 && g[0].abs() < 1e-12);
+        let (d, g) = lane.distance_and_gradient([5.0, 0.0]);
+        assert!(d == 0.0 && g == [0.0, 1.0]);
+        // Beyond the start: away from the origin point.
+        let (d, g) = lane.distance_and_gradient([-3.0, -4.0]);
+        assert!(
+            (d - 5.0).abs() < 1e-12 && (g[0] + 0.6).abs() < 1e-12 && (g[1] + 0.8).abs() < 1e-12
+        );
+        // Matches finite differences off the route.
+        let p = [7.0, 1.3];
+        let e = 1e-6;
+        let fd = [
+            (lane.distance_and_gradient([p[0] + e, p[1]]).0
+                - lane.distance_and_gradient([p[0] - e, p[1]]).0)
+                / (2.0 * e),
+            (lane.distance_and_gradient([p[0], p[1] + e]).0
+                - lane.distance_and_gradient([p[0], p[1] - e]).0)
+                / (2.0 * e),
+        ];
+        let g = lane.distance_and_gradient(p).1;
+        assert!((fd[0] - g[0]).abs() < 1e-6 && (fd[1] - g[1]).abs() < 1e-6);
+    }
+
+    #[test]
+    fn lane_round_trips_through_json() {
+        let lane = l_lane();
+        let text = serde_json::to_string(&lane).unwrap();
+        assert_eq!(
+            text,
+            r#"{"centre":[[0.0,0.0],[10.0,0.0],[10.0,10.0]],"half_width":2.0}"#
+        );
+        let back: Lane = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, lane);
+    }
+
+    #[test]
+    fn the_paper_lane() {
+        let s = Scenario::paper().unwrap();
+        let lane = Lane::of_scenario(&s).unwrap();
+        assert_eq!(lane.half_width, 5.0);
+        assert_eq!(lane.centre.points().len(), s.route.waypoints.len() + 2);
+        assert!((lane.centre.length() - s.route.length()).abs() < 1e-9);
+    }
+}
