@@ -7,6 +7,7 @@
 #![deny(unsafe_code)]
 
 pub mod logging;
+pub mod outputs;
 pub mod params;
 pub mod plant;
 pub mod variables;

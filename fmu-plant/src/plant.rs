@@ -14,6 +14,7 @@
 //! `towing-interface`'s [`RunSession`], which the controller uses too.
 
 use crate::logging::{self, LogScenario, StepSnapshot};
+use crate::outputs::{Groundings, OUTPUTS};
 use crate::params::{PlantParams, PARAMETERS};
 use crate::variables::{self as vars, PlantVariable};
 use fmi2_slave::codec::{put_bytes, put_f64, put_header, put_str, put_value, Reader};
@@ -39,6 +40,8 @@ const STATE_MAGIC: &[u8; 4] = b"TWPL";
 #[derive(Debug, Clone)]
 struct Built {
     world: World,
+    /// Which hulls are aground ([`crate::outputs`]).
+    groundings: Groundings,
     /// Shared with the log's writer thread.
     log_info: Arc<LogScenario>,
 }
@@ -69,6 +72,7 @@ impl Plant {
             let world = World::new(scenario, params.world_config(scenario))
                 .map_err(|e| format!("{}: {e}", file.origin))?;
             Ok(Built {
+                groundings: Groundings::of(&world),
                 world,
                 log_info: Arc::new(LogScenario::of(scenario)),
             })
@@ -135,7 +139,12 @@ impl Plant {
             logging::register_topics(writer)?;
             logging::write_static_scene(writer, t, &built.world, &built.log_info)?;
             let snap = StepSnapshot::capture(t, &built.world, inputs);
-            logging::write_state(writer, &snap, &built.log_info, true)
+            logging::write_state(writer, &snap, &built.log_info, true)?;
+            // A hull aground from the start: its episode begins now.
+            for event in Groundings::default().update(&built.world) {
+                logging::write_log_line(writer, t, Log::WARNING, &event.message(t))?;
+            }
+            Ok(())
         })
     }
 
@@ -223,7 +232,7 @@ impl Fmi2Model for Plant {
             PlantVariable::Contract(c) => real_output(self.world(), c).ok_or_else(|| {
                 vars::VARIABLES.unhandled(ValueType::Real, PlantVariable::Contract(c), "get")
             })?,
-            other @ PlantVariable::Session(_) => {
+            other @ (PlantVariable::Session(_) | PlantVariable::Output(_)) => {
                 return Err(vars::VARIABLES.unhandled(ValueType::Real, other, "get"))
             }
         })
@@ -285,6 +294,10 @@ impl Fmi2Model for Plant {
             PlantVariable::Contract(ContractVariable::Towline(line, TowlineField::Slack)) => {
                 Ok(self.world().is_none_or(|w| w.towline(line.index()).slack))
             }
+            PlantVariable::Output(i) => Ok(self
+                .built
+                .as_ref()
+                .is_some_and(|b| (OUTPUTS[i].get)(&b.groundings))),
             other => Err(vars::VARIABLES.unhandled(ValueType::Boolean, other, "get")),
         }
     }
@@ -321,8 +334,12 @@ impl Fmi2Model for Plant {
         let Some(built) = self.built.as_mut() else {
             return StepOutcome::Error("no scenario is loaded".to_owned());
         };
+        let mut groundings = Vec::new();
         let outcome = match built.world.step(&self.inputs, step.step_size) {
-            Ok(()) => StepOutcome::Ok,
+            Ok(()) => {
+                groundings = built.groundings.update(&built.world);
+                StepOutcome::Ok
+            }
             Err(e) => StepOutcome::Discard(format!(
                 "step from t = {} s by h = {} s refused: {e}; the state is left at t = {} s",
                 step.current_time,
@@ -331,9 +348,24 @@ impl Fmi2Model for Plant {
             )),
         };
         // A logging failure is a warning (docs/interface.md, "MCAP log").
+        let t_end = step.current_time + step.step_size;
         let failed = self.session.log_step(|| match &outcome {
             StepOutcome::Ok | StepOutcome::Warning(_) => {
-                self.state_messages(step.current_time, step.current_time + step.step_size)
+                let state = self.state_messages(step.current_time, t_end);
+                let lines: Vec<Batch> = groundings
+                    .iter()
+                    .map(|g| Self::line_message(t_end, Log::WARNING, &g.message(t_end)))
+                    .collect();
+                if lines.is_empty() {
+                    state
+                } else {
+                    Some(Box::new(move |w| {
+                        if let Some(state) = state {
+                            state(w)?;
+                        }
+                        lines.into_iter().try_for_each(|line| line(w))
+                    }))
+                }
             }
             StepOutcome::Discard(m) | StepOutcome::Error(m) => {
                 Some(Self::line_message(step.current_time, Log::ERROR, m))
@@ -426,7 +458,11 @@ impl Fmi2Model for Plant {
                 World::new(&file.scenario, config).map_err(|e| format!("{}: {e}", file.origin))?;
             world.read_state(world_bytes)?;
             let log_info = Arc::new(LogScenario::of(&file.scenario));
-            restored.built = Some(Built { world, log_info });
+            restored.built = Some(Built {
+                groundings: Groundings::of(&world),
+                world,
+                log_info,
+            });
             loaded = Some(file);
         }
         r.finish()?;

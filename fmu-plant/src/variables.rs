@@ -10,7 +10,8 @@
 //! parameters `scenario`, `log_file`, `run_id` of [`towing_interface::session::PARAMETERS`],
 //! value references 1, 2, 3) and the plant's own (the registry of [`crate::params`], value
 //! references `10 + index`); the plant adds the Boolean outputs `towlineN.slack` (the
-//! contract's [`TowlineField::Slack`]).
+//! contract's [`TowlineField::Slack`]) and its own outputs ([`crate::outputs::OUTPUTS`]:
+//! `ship.aground`, `tug1.aground`, `tug2.aground`).
 //!
 //! The plant's getters and setters decode every value reference through [`VARIABLES`]
 //! into a [`PlantVariable`] and match on it.
@@ -24,6 +25,7 @@ use towing_interface::codec::{
 use towing_interface::variables::{self as shared, Direction};
 use towing_interface::{parameters, session, vr, ModelInfo};
 
+use crate::outputs::{self, OUTPUTS};
 use crate::params::PARAMETERS;
 
 pub use towing_interface::vr::{
@@ -49,6 +51,8 @@ pub enum PlantVariable {
     Session(usize),
     /// A parameter: its index in the registry ([`PARAMETERS`]).
     Parameter(usize),
+    /// One of the plant's own outputs: its index in [`OUTPUTS`].
+    Output(usize),
 }
 
 impl ModelVariable for PlantVariable {
@@ -57,6 +61,7 @@ impl ModelVariable for PlantVariable {
             PlantVariable::Contract(c) => c.encode(),
             PlantVariable::Session(i) => vr::session_parameter(i),
             PlantVariable::Parameter(i) => parameter_vr(i),
+            PlantVariable::Output(i) => OUTPUTS[i].value_reference,
         }
     }
 
@@ -65,6 +70,7 @@ impl ModelVariable for PlantVariable {
             PlantVariable::Contract(c) => c.value_type(),
             PlantVariable::Session(i) => parameters::value_type(&session::PARAMETERS[i]),
             PlantVariable::Parameter(i) => parameters::value_type(&PARAMETERS[i]),
+            PlantVariable::Output(_) => ValueType::Boolean,
         }
     }
 
@@ -80,12 +86,14 @@ impl ModelVariable for PlantVariable {
 pub static VARIABLES: LazyLock<VariableTable<PlantVariable>> = LazyLock::new(|| {
     let session = (0..session::PARAMETERS.len()).map(PlantVariable::Session);
     let own = (0..PARAMETERS.len()).map(PlantVariable::Parameter);
+    let outputs = (0..OUTPUTS.len()).map(PlantVariable::Output);
     VariableTable::new(
         MODEL_IDENTIFIER,
         ContractVariable::all()
             .map(PlantVariable::Contract)
             .chain(session)
-            .chain(own),
+            .chain(own)
+            .chain(outputs),
     )
 });
 
@@ -124,5 +132,6 @@ fn build() -> ModelDescription {
         ));
     }
     v.extend(shared::obstacles(Direction::Output));
+    v.extend(outputs::variables());
     INFO.model_description(v, &parameters::enumerations(PARAMETERS))
 }

@@ -388,3 +388,68 @@ fn a_log_write_failure_is_reported_by_the_next_step_every_time() {
         );
     }
 }
+
+/// Groundings: in a waterway 0.1 m wide each side every hull pokes beyond the bank from
+/// the start (the ship's half beam is 0.145 m): the three `*.aground` outputs are true
+/// and the log holds one grounding event per vessel at the start time, none after (the
+/// episodes go on); in the paper's 5 m waterway nothing is aground (the run test above:
+/// no `/plant/log` message).
+#[test]
+fn a_hull_beyond_the_bank_is_aground_and_logged_once_per_episode() {
+    use towing_plant::outputs::OUTPUTS;
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = dir.path().join("narrow.toml");
+    let text = testing::read_repository_file("scenarios/paper.toml").replace(
+        "[waterway]\nhalf_width = 5.0",
+        "[waterway]\nhalf_width = 0.1",
+    );
+    assert!(text.contains("half_width = 0.1"));
+    std::fs::write(&scenario, text).unwrap();
+    let path = dir.path().join("plant.mcap");
+    let fmu = plant_logging_to("narrow", &path);
+    assert_eq!(
+        fmu.set_string(vars::SCENARIO, scenario.to_str().unwrap()),
+        Fmi2Status::Ok
+    );
+    fmu.init(0.0, None);
+    for o in &OUTPUTS {
+        assert!(fmu.get_boolean(o.value_reference), "{}", o.name);
+    }
+    pull(&fmu);
+    steps(&fmu, 0.0, 20);
+    for o in &OUTPUTS {
+        assert!(fmu.get_boolean(o.value_reference), "{}", o.name);
+    }
+    assert_eq!(fmu.terminate(), Fmi2Status::Ok, "{}", fmu.log_text());
+    let (msgs, _) = read_log_messages(&std::fs::read(&path).unwrap());
+    let events: Vec<(u64, Log)> = msgs[names::PLANT_LOG]
+        .iter()
+        .map(|(t, d)| (*t, serde_json::from_slice(d).unwrap()))
+        .collect();
+    assert_eq!(events.len(), 3, "{events:?}");
+    for ((t, e), vessel) in events.iter().zip(["ship", "tug1", "tug2"]) {
+        assert_eq!((*t, e.level), (0, Log::WARNING));
+        assert!(
+            e.message
+                .starts_with(&format!("grounding: {vessel} aground at t = 0.000 s")),
+            "{}",
+            e.message
+        );
+    }
+}
+
+/// The outputs are Booleans of their own in the model description.
+#[test]
+fn the_aground_outputs_are_in_the_model_description() {
+    use towing_plant::outputs::OUTPUTS;
+    for (o, name) in OUTPUTS
+        .iter()
+        .zip(["ship.aground", "tug1.aground", "tug2.aground"])
+    {
+        assert_eq!(o.name, name);
+        let v = DESCRIPTION
+            .find(fmi2_slave::ValueType::Boolean, o.value_reference)
+            .unwrap();
+        assert_eq!(v.name, name);
+    }
+}
