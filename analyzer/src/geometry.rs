@@ -1,11 +1,17 @@
 //! Plane geometry in the NED frame: points are `[north, east]` in m, headings from North,
 //! clockwise (Fossen 2021; `paper/NOTES.md` section 1: forward unit vector
-//! `(cos psi, sin psi)`).
+//! `(cos psi, sin psi)`). The hull footprint, the route polyline and the waterway are the
+//! plant's and the MPC's own ([`towing_model::geometry`], re-exported here), so the
+//! analyzer judges contact and groundings with the geometry the plant reports them by.
 
 use std::f64::consts::PI;
 
+pub use towing_model::geometry::{
+    body_to_ned, dist, segment_projection, HullRect, Lane, Polyline, Projection,
+};
+
 /// A point `[north, east]`, m.
-pub type P2 = [f64; 2];
+pub type P2 = towing_model::geometry::Point;
 
 /// Wraps an angle to `(-pi, pi]`.
 #[must_use]
@@ -15,26 +21,6 @@ pub fn wrap(a: f64) -> f64 {
         w -= 2.0 * PI;
     }
     w
-}
-
-/// Body point `(bx forward, by starboard)` of a vessel at `(x, y, psi)`, in NED.
-#[must_use]
-pub fn body_to_ned(x: f64, y: f64, psi: f64, bx: f64, by: f64) -> P2 {
-    let (s, c) = psi.sin_cos();
-    [x + bx * c - by * s, y + bx * s + by * c]
-}
-
-/// The hull rectangle of a vessel (length x width centred at its body origin), corners
-/// in order bow-starboard, bow-port, stern-port, stern-starboard.
-#[must_use]
-pub fn hull_rect(x: f64, y: f64, psi: f64, length: f64, width: f64) -> [P2; 4] {
-    let (a, b) = (length / 2.0, width / 2.0);
-    [
-        body_to_ned(x, y, psi, a, b),
-        body_to_ned(x, y, psi, a, -b),
-        body_to_ned(x, y, psi, -a, -b),
-        body_to_ned(x, y, psi, -a, b),
-    ]
 }
 
 /// A hull outline for maps: the rectangle with a pointed bow (the bow's tip on the centre
@@ -67,12 +53,6 @@ pub fn ellipse(x: f64, y: f64, psi: f64, a: f64, b: f64, n: usize) -> Vec<P2> {
 #[must_use]
 pub fn circle(x: f64, y: f64, r: f64, n: usize) -> Vec<P2> {
     ellipse(x, y, 0.0, r, r, n)
-}
-
-/// Euclidean distance.
-#[must_use]
-pub fn dist(a: P2, b: P2) -> f64 {
-    (a[0] - b[0]).hypot(a[1] - b[1])
 }
 
 /// True when a vessel's hull rectangle and a circle overlap (touching counts): the circle's
@@ -134,97 +114,6 @@ pub fn ellipse_polygon(x: f64, y: f64, psi: f64, a: f64, b: f64) -> Vec<P2> {
 #[must_use]
 pub fn relative_bearing(from: P2, psi: f64, to: P2) -> f64 {
     wrap((to[1] - from[1]).atan2(to[0] - from[0]) - psi)
-}
-
-// Route, CPA and line geometry of the seamanship and rule verdicts.
-
-/// The route as a polyline through its points (origin, waypoints, destination).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Polyline {
-    points: Vec<P2>,
-    /// Arc length at each point, m (`cum[0] = 0`).
-    cum: Vec<f64>,
-}
-
-/// A point's nearest point on a [`Polyline`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Projection {
-    /// Arc length of the nearest point from the route's start, m.
-    pub s: f64,
-    /// Distance from the route, m.
-    pub distance: f64,
-}
-
-impl Polyline {
-    /// The polyline through the route points' positions (`[north, east, heading]`); `None`
-    /// without a point.
-    #[must_use]
-    pub fn from_route(route: &[[f64; 3]]) -> Option<Self> {
-        if route.is_empty() {
-            return None;
-        }
-        let points: Vec<P2> = route.iter().map(|p| [p[0], p[1]]).collect();
-        let mut cum = Vec::with_capacity(points.len());
-        cum.push(0.0);
-        for w in points.windows(2) {
-            let last = cum.last().copied().unwrap_or(0.0);
-            cum.push(last + dist(w[0], w[1]));
-        }
-        Some(Polyline { points, cum })
-    }
-
-    /// Total length, m.
-    #[must_use]
-    pub fn length(&self) -> f64 {
-        self.cum.last().copied().unwrap_or(0.0)
-    }
-
-    /// The last point (the destination).
-    #[must_use]
-    pub fn end(&self) -> P2 {
-        self.points[self.points.len() - 1]
-    }
-
-    /// The nearest point of any segment to `p` (the first segment on a tie): its arc length
-    /// and distance. A one-point route projects every point onto that point (`s = 0`).
-    #[must_use]
-    pub fn project(&self, p: P2) -> Projection {
-        let mut best = Projection {
-            s: 0.0,
-            distance: dist(p, self.points[0]),
-        };
-        for (k, w) in self.points.windows(2).enumerate() {
-            let (f, d) = segment_projection(p, w[0], w[1]);
-            if d < best.distance {
-                best = Projection {
-                    s: self.cum[k] + f * (self.cum[k + 1] - self.cum[k]),
-                    distance: d,
-                };
-            }
-        }
-        best
-    }
-
-    /// Distance of `p` from the route (nearest point of any segment), m.
-    #[must_use]
-    pub fn distance(&self, p: P2) -> f64 {
-        self.project(p).distance
-    }
-}
-
-/// The fraction along `a`-`b` (in `[0, 1]`) of the point of the segment nearest to `p`, and
-/// the distance to it. A zero-length segment is its point.
-#[must_use]
-pub fn segment_projection(p: P2, a: P2, b: P2) -> (f64, f64) {
-    let ab = [b[0] - a[0], b[1] - a[1]];
-    let len2 = ab[0] * ab[0] + ab[1] * ab[1];
-    let f = if len2 > 0.0 {
-        (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let q = [a[0] + f * ab[0], a[1] + f * ab[1]];
-    (f, dist(p, q))
 }
 
 /// Time and distance of the closest point of approach of a target at `p_target` moving
@@ -301,7 +190,7 @@ pub fn hull_ellipse_clearance(
 ) -> f64 {
     let (ex, ey, epsi, el, ew) = ellipse;
     let (a, b) = (el / 2.0, ew / 2.0);
-    let corners = crate::geometry::hull_rect(hull.0, hull.1, hull.2, hull.3, hull.4);
+    let corners = HullRect::new(hull.3, hull.4).corners(hull.0, hull.1, hull.2);
     if a > 0.0
         && b > 0.0
         && corners.iter().any(|&c| {
@@ -343,13 +232,6 @@ mod tests {
     }
 
     #[test]
-    fn hull_corners_follow_heading() {
-        // Heading East: the bow is East of the centre.
-        let h = hull_rect(0.0, 0.0, PI / 2.0, 2.0, 1.0);
-        assert!((h[0][1] - 1.0).abs() < 1e-12 && (h[0][0] + 0.5).abs() < 1e-12);
-    }
-
-    #[test]
     fn rect_circle() {
         let hull = (0.0, 0.0, 0.0, 2.0, 1.0);
         assert!(rect_circle_overlap(hull, [1.4, 0.0], 0.5));
@@ -360,9 +242,10 @@ mod tests {
 
     #[test]
     fn sat_overlap() {
-        let a = hull_rect(0.0, 0.0, 0.0, 2.0, 1.0);
-        let b = hull_rect(0.0, 1.2, 0.3, 2.0, 1.0);
-        let c = hull_rect(0.0, 3.0, 0.0, 2.0, 1.0);
+        let hull = HullRect::new(2.0, 1.0);
+        let a = hull.corners(0.0, 0.0, 0.0);
+        let b = hull.corners(0.0, 1.2, 0.3);
+        let c = hull.corners(0.0, 3.0, 0.0);
         assert!(convex_overlap(&a, &b));
         assert!(!convex_overlap(&a, &c));
         let e = ellipse_polygon(0.0, 1.6, 0.0, 0.74, 0.24);
@@ -375,18 +258,6 @@ mod tests {
 #[cfg(test)]
 mod route_tests {
     use super::*;
-
-    #[test]
-    fn projection_on_an_l_shaped_route() {
-        let route = [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 10.0, 0.0]];
-        let p = Polyline::from_route(&route).expect("points");
-        assert_eq!(p.length(), 20.0);
-        let q = p.project([5.0, -2.0]);
-        assert!((q.s - 5.0).abs() < 1e-12 && (q.distance - 2.0).abs() < 1e-12);
-        let q = p.project([12.0, 4.0]);
-        assert!((q.s - 14.0).abs() < 1e-12 && (q.distance - 2.0).abs() < 1e-12);
-        assert!((p.distance([-3.0, 4.0]) - 5.0).abs() < 1e-12);
-    }
 
     #[test]
     fn cpa_of_a_crossing() {

@@ -367,6 +367,7 @@ fn seamanship_waterway_excursion_of_1_m_for_50_s() {
     assert!(close(w.time_outside_s, 50.0, 1e-9));
     // One grounding event per vessel, all three over the same 100 steps.
     assert_eq!(w.groundings.len(), 3, "{w:?}");
+    assert_eq!(w.groundings_per_vessel, [1, 1, 1], "{w:?}");
     for (g, name) in w.groundings.iter().zip(["ship", "tug1", "tug2"]) {
         assert_eq!(g.vessel, name);
         assert_eq!((g.t_start_s, g.t_end_s, g.samples), (200.5, 250.0, 100));

@@ -10,7 +10,7 @@ use super::{StepFacts, summary_row, FinishContext, Metric, Metrics, ReportPart, 
 use crate::doc::Block;
 use crate::error::Result;
 use crate::frames::PlantBatch;
-use crate::geometry::{convex_overlap, ellipse_polygon, hull_rect, rect_circle_overlap};
+use crate::geometry::{convex_overlap, ellipse_polygon, rect_circle_overlap, HullRect};
 use crate::metrics::{CollisionEvent, OverlapTracker};
 use crate::rows::{slot_index, ObstacleRows, VESSELS};
 use crate::step::PlantStep;
@@ -53,7 +53,7 @@ fn overlaps_obstacle(pose: [f64; 3], size: [f64; 2], obs: [f64; 6], ship: bool) 
     if !(x.is_finite() && y.is_finite() && psi.is_finite()) {
         false
     } else if ship {
-        let hull = hull_rect(x, y, psi, size[0], size[1]);
+        let hull = HullRect::new(size[0], size[1]).corners(x, y, psi);
         let e = ellipse_polygon(ox, oy, opsi, olen / 2.0, owid / 2.0);
         convex_overlap(&hull, &e)
     } else {
@@ -80,8 +80,8 @@ impl Metric for Collisions {
         for (p, &(a, b)) in PAIRS.iter().enumerate() {
             let (va, vb) = (&s.vessels[a], &s.vessels[b]);
             let (sa, sb) = (self.sizes[a], self.sizes[b]);
-            let ha = hull_rect(va.x, va.y, va.psi, sa[0], sa[1]);
-            let hb = hull_rect(vb.x, vb.y, vb.psi, sb[0], sb[1]);
+            let ha = HullRect::new(sa[0], sa[1]).corners(va.x, va.y, va.psi);
+            let hb = HullRect::new(sb[0], sb[1]).corners(vb.x, vb.y, vb.psi);
             let overlap = ha
                 .iter()
                 .chain(&hb)

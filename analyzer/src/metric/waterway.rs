@@ -1,13 +1,15 @@
 //! Waterway: how far the hulls of the three vessels go beyond the scenario's half width.
 //!
-//! For every hull corner (rectangle length x width centred at the body origin, oriented by
-//! the heading, [`crate::geometry::hull_rect`]) of the ship and the two tugs, the distance
-//! from the route polyline (nearest point of any segment, [`Polyline::distance`]) minus the
-//! half width is its excess. A vessel with a corner beyond `half_width +
-//! waterway_tolerance_m` is aground: a grounding event is a maximal run of consecutive
-//! steps with that vessel aground (as the hull-overlap events of the `collisions` metric),
-//! and any grounding fails the run. Without a `[waterway]` (or a route) the metric
-//! reports "no waterway" and never gives a reason.
+//! For every hull corner (the footprint [`HullRect`]: length x width centred at the body
+//! origin, oriented by the heading) of the ship and the two tugs, the distance from the
+//! route polyline (nearest point of any segment) minus the half width is its excess
+//! ([`Lane::hull_excess`]: the plant's own judgement, `World::bank_excess`, which sets its
+//! `*.aground` outputs and logs a grounding event). A vessel with a corner beyond
+//! `half_width + waterway_tolerance_m` is aground: a grounding event is a maximal run of
+//! consecutive steps with that vessel aground (as the hull-overlap events of the
+//! `collisions` metric), counted per vessel, and any grounding fails the run. With the
+//! default tolerance 0 the events are the plant's grounding episodes. Without a
+//! `[waterway]` (or a route) the metric reports "no waterway" and never gives a reason.
 
 use serde::{Deserialize, Serialize};
 
@@ -15,10 +17,9 @@ use super::{summary_row, FinishContext, Metric, Metrics, ReportPart, RunContext,
 use crate::doc::Block;
 use crate::error::Result;
 
-use crate::geometry::Polyline;
+use crate::geometry::{HullRect, Lane, Polyline};
 use crate::rows::VESSELS;
 use crate::step::StepClock;
-use crate::geometry::hull_rect;
 use crate::step::{PlantStep, RunGeometry};
 use crate::thresholds::Thresholds;
 use crate::verdict::Reason;
@@ -56,14 +57,16 @@ pub struct WaterwayReport {
     pub time_outside_s: f64,
     /// Grounding events (beyond half width + tolerance), in order of their start.
     pub groundings: Vec<Grounding>,
+    /// Grounding events per vessel: ship, tug 1, tug 2.
+    #[serde(default)]
+    pub groundings_per_vessel: [usize; 3],
 }
 
 /// The waterway tracker (O(1) besides the route and the events).
 #[derive(Debug, Clone)]
 pub struct WaterwayTracker {
-    route: Option<Polyline>,
-    half_width: Option<f64>,
-    sizes: [[f64; 2]; 3],
+    lane: Option<Lane>,
+    hulls: [HullRect; 3],
     tolerance: f64,
     clock: StepClock,
     max: Option<(f64, f64, usize)>,
@@ -77,9 +80,10 @@ impl WaterwayTracker {
     #[must_use]
     pub fn new(geometry: &RunGeometry, thresholds: &Thresholds) -> Self {
         WaterwayTracker {
-            route: Polyline::from_route(&geometry.route),
-            half_width: geometry.half_width,
-            sizes: geometry.sizes,
+            lane: Polyline::from_route(&geometry.route)
+                .zip(geometry.half_width)
+                .map(|(centre, hw)| Lane::new(centre, hw)),
+            hulls: geometry.sizes.map(|[l, w]| HullRect::new(l, w)),
             tolerance: thresholds.waterway_tolerance_m,
             clock: StepClock::default(),
             max: None,
@@ -92,16 +96,12 @@ impl WaterwayTracker {
     /// The next step.
     pub fn push(&mut self, step: &PlantStep<'_>) {
         let dt = self.clock.dt(step.t);
-        let (Some(route), Some(hw)) = (&self.route, self.half_width) else {
+        let Some(lane) = &self.lane else {
             return;
         };
         let mut outside = false;
         for (k, v) in step.vessels.iter().enumerate() {
-            let [l, w] = self.sizes[k];
-            let excess = hull_rect(v.x, v.y, v.psi, l, w)
-                .iter()
-                .map(|&c| route.distance(c) - hw)
-                .fold(f64::NEG_INFINITY, f64::max);
+            let excess = lane.hull_excess(&self.hulls[k], v.x, v.y, v.psi);
             outside |= excess > 0.0;
             if self.max.is_none_or(|(m, _, _)| excess > m) {
                 self.max = Some((excess, step.t, k));
@@ -139,15 +139,22 @@ impl WaterwayTracker {
         }
         self.events
             .sort_by(|a, b| a.t_start_s.total_cmp(&b.t_start_s));
-        let judged = self.route.is_some() && self.half_width.is_some();
+        let mut per_vessel = [0; 3];
+        for g in &self.events {
+            if let Some(k) = VESSELS.iter().position(|&v| v == g.vessel) {
+                per_vessel[k] += 1;
+            }
+        }
+        let judged = self.lane.is_some();
         WaterwayReport {
-            half_width_m: self.half_width,
+            half_width_m: self.lane.as_ref().map(|l| l.half_width),
             note: (!judged).then(|| "no waterway".to_owned()),
             max_excess_m: self.max.map(|m| m.0),
             t_max_s: self.max.map(|m| m.1),
             max_vessel: self.max.map(|m| VESSELS[m.2].to_owned()),
             time_outside_s: self.time_outside,
             groundings: self.events,
+            groundings_per_vessel: per_vessel,
         }
     }
 }
@@ -192,9 +199,12 @@ impl Metric for WaterwayTracker {
         let value = match (&m.note, m.max_excess_m, m.t_max_s, &m.max_vessel) {
             (Some(note), ..) => note.clone(),
             (None, Some(e), Some(t), Some(v)) => format!(
-                "{e:.2} m ({v}, {t:.1} s); {:.1} s outside; {} grounding(s)",
+                "{e:.2} m ({v}, {t:.1} s); {:.1} s outside; {} grounding(s) (ship / tug1 / tug2: {} / {} / {})",
                 m.time_outside_s,
-                m.groundings.len()
+                m.groundings.len(),
+                m.groundings_per_vessel[0],
+                m.groundings_per_vessel[1],
+                m.groundings_per_vessel[2]
             ),
             _ => "-".to_owned(),
         };
