@@ -139,6 +139,7 @@ pub const INFO: ModelInfo = ModelInfo {
         RealType::new("PositionWeight", "1/m2", None, (0, -2, 0, 0)),
         RealType::new("HeadingWeight", "1/rad2", None, (0, 0, 0, -2)),
         RealType::new("SpeedWeight", "s2/m2", None, (0, -2, 2, 0)),
+        RealType::new("SpeedPenalty", "s/m", None, (0, -1, 1, 0)),
         RealType::new("YawRateWeight", "s2/rad2", None, (0, 0, 2, -2)),
         RealType::new("ForceWeight", "1/N2", None, (-2, -2, 4, 0)),
         RealType::new("MomentWeight", "1/(N.m)2", None, (-2, -4, 4, 0)),
@@ -150,9 +151,8 @@ pub const INFO: ModelInfo = ModelInfo {
 pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(build);
 
 /// The `modelDescription.xml` of the FMU: [`DESCRIPTION`] as XML. It declares
-/// `canGetAndSetFMUstate` and `canSerializeFMUstate` false (the solvers' warm starts
-/// and factorisations are not copied or serialised), and `fmi2-slave` refuses those
-/// functions accordingly.
+/// `canGetAndSetFMUstate` and `canSerializeFMUstate` true (`ControllerState`; the
+/// solvers' factorisations are rebuilt on restore).
 #[must_use]
 pub fn model_description_xml() -> String {
     DESCRIPTION.to_xml()
