@@ -38,8 +38,7 @@ use fmi2_slave::{Fmi2Model, InstanceContext, Logger, StepContext, StepOutcome, V
 use serde::{Deserialize, Serialize};
 use towing_control::params::{Value, PARAMETERS};
 use towing_control::{
-    ConfigError, Controller, ControllerConfig, ControllerState, Measurement, SampleReport,
-    Tuning,
+    ConfigError, Controller, ControllerConfig, ControllerState, Measurement, SampleReport, Tuning,
 };
 use towing_interface::codec::{
     obstacle_kind_code, obstacle_kind_from_code, ContractVariable, ObstacleField, TowlineField,

@@ -199,10 +199,16 @@ fn the_reference_course_turns_at_a_bounded_rate_and_carries_the_tracked_point() 
     for k in 0..5 {
         let r = c.sample(&m).unwrap().reference;
         let turn = towing_model::wrap_angle(r[2] - previous);
-        assert!(turn > 0.0 && turn <= step + 1e-12, "sample {k}: turned {turn} rad");
+        assert!(
+            turn > 0.0 && turn <= step + 1e-12,
+            "sample {k}: turned {turn} rad"
+        );
         assert!(towing_model::wrap_angle(r[2] - psi).abs() <= t.course_lead + 1e-12);
         let (dx, dy) = (r[0] - m.ship[0], r[1] - m.ship[1]);
-        assert!((dy.atan2(dx) - r[2]).abs() < 1e-9, "the point lies on the course");
+        assert!(
+            (dy.atan2(dx) - r[2]).abs() < 1e-9,
+            "the point lies on the course"
+        );
         assert!(dx.hypot(dy) <= t.lookahead.max(t.los_distance) + 1e-9);
         previous = r[2];
     }

@@ -52,8 +52,8 @@ pub mod reference;
 pub mod waypoint;
 
 pub use colregs::{
-    action, classify, role, safe_reading, Action, ColregsSettings, Encounter, EncounterThresholds, Manoeuvre,
-    Role, Rule17Settings, Situation, ThresholdPreset, TowStatus,
+    action, classify, role, safe_reading, Action, ColregsSettings, Encounter, EncounterThresholds,
+    Manoeuvre, Role, Rule17Settings, Situation, ThresholdPreset, TowStatus,
 };
 pub use distance::{ActiveObstacle, Ellipse};
 pub use error::{InputError, ParamError};

@@ -312,7 +312,8 @@ fn past_and_clear(
         situation,
         Situation::HeadOn | Situation::Overtaking | Situation::BeingOvertaken
     );
-    let beta = crate::geometry::relative_bearing(tow.ship.x, tow.ship.y, tow.ship.psi, target.centre);
+    let beta =
+        crate::geometry::relative_bearing(tow.ship.x, tow.ship.y, tow.ship.psi, target.centre);
     let abaft = beta.abs() > std::f64::consts::FRAC_PI_2;
     if !(abaft || (crossed && !along_track)) {
         return false;
@@ -947,7 +948,11 @@ mod tests {
         );
         assert!(!out.altered && rs.stands_on(0));
         // 2.5 m astern: TCPA 36 s, still standing on; 1.5 m astern: TCPA 21 s.
-        assert!(!rs.update(&tow, &[vessel(-2.5, 2.0, 0.0, 0.12)]).unwrap().altered);
+        assert!(
+            !rs.update(&tow, &[vessel(-2.5, 2.0, 0.0, 0.12)])
+                .unwrap()
+                .altered
+        );
         assert!(rs.stands_on(0));
         rs.update(&tow, &[vessel(-1.5, 2.0, 0.0, 0.12)]).unwrap();
         assert!(!rs.stands_on(0));

@@ -30,7 +30,9 @@
 
 use nalgebra::Matrix6x4;
 
-use crate::costs::{angle_difference, obstacle_terms, ship_stage_terms, ClearanceParams, MotionLimits};
+use crate::costs::{
+    angle_difference, obstacle_terms, ship_stage_terms, ClearanceParams, MotionLimits,
+};
 use crate::engine::{
     Block, BlockMut, Channel, InputSpace, QuadModel, RowSet, Scp, ScpSettings, SlotRows,
     Subproblem, ALL_VESSELS,
