@@ -34,19 +34,19 @@ pub struct PlantOutput {
 /// The plant's own outputs (module docs).
 pub static OUTPUTS: [PlantOutput; 3] = [
     PlantOutput {
-        name: "ship.aground",
+        name: "aground.ship",
         value_reference: 400,
         description: "true while a corner of the ship's hull (length x beam) is beyond the waterway's bank (farther than the scenario's half width from the route); false without a waterway",
         get: |g| g.aground[0],
     },
     PlantOutput {
-        name: "tug1.aground",
+        name: "aground.tug1",
         value_reference: 401,
         description: "true while a corner of tug 1's hull (length x beam) is beyond the waterway's bank (farther than the scenario's half width from the route); false without a waterway",
         get: |g| g.aground[1],
     },
     PlantOutput {
-        name: "tug2.aground",
+        name: "aground.tug2",
         value_reference: 402,
         description: "true while a corner of tug 2's hull (length x beam) is beyond the waterway's bank (farther than the scenario's half width from the route); false without a waterway",
         get: |g| g.aground[2],

@@ -11,7 +11,7 @@
 //! value references 1, 2, 3) and the plant's own (the registry of [`crate::params`], value
 //! references `10 + index`); the plant adds the Boolean outputs `towlineN.slack` (the
 //! contract's [`TowlineField::Slack`]) and its own outputs ([`crate::outputs::OUTPUTS`]:
-//! `ship.aground`, `tug1.aground`, `tug2.aground`).
+//! `aground.ship`, `aground.tug1`, `aground.tug2`).
 //!
 //! The plant's getters and setters decode every value reference through [`VARIABLES`]
 //! into a [`PlantVariable`] and match on it.

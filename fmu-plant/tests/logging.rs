@@ -390,7 +390,7 @@ fn a_log_write_failure_is_reported_by_the_next_step_every_time() {
 }
 
 /// Groundings: in a waterway 0.1 m wide each side every hull pokes beyond the bank from
-/// the start (the ship's half beam is 0.145 m): the three `*.aground` outputs are true
+/// the start (the ship's half beam is 0.145 m): the three `aground.*` outputs are true
 /// and the log holds one grounding event per vessel at the start time, none after (the
 /// episodes go on); in the paper's 5 m waterway nothing is aground (the run test above:
 /// no `/plant/log` message).
@@ -444,7 +444,7 @@ fn the_aground_outputs_are_in_the_model_description() {
     use towing_plant::outputs::OUTPUTS;
     for (o, name) in OUTPUTS
         .iter()
-        .zip(["ship.aground", "tug1.aground", "tug2.aground"])
+        .zip(["aground.ship", "aground.tug1", "aground.tug2"])
     {
         assert_eq!(o.name, name);
         let v = DESCRIPTION

@@ -4,7 +4,7 @@
 //! origin, oriented by the heading) of the ship and the two tugs, the distance from the
 //! route polyline (nearest point of any segment) minus the half width is its excess
 //! ([`Lane::hull_excess`]: the plant's own judgement, `World::bank_excess`, which sets its
-//! `*.aground` outputs and logs a grounding event). A vessel with a corner beyond
+//! `aground.*` outputs and logs a grounding event). A vessel with a corner beyond
 //! `half_width + waterway_tolerance_m` is aground: a grounding event is a maximal run of
 //! consecutive steps with that vessel aground (as the hull-overlap events of the
 //! `collisions` metric), counted per vessel, and any grounding fails the run. With the
