@@ -30,7 +30,8 @@ def test_demo_writes_the_report_and_says_where_it_is():
     assert metrics["truncated"] is False
     assert metrics["collisions"] == 0
     assert metrics["fallbacks"] == 0
-    assert 900.0 < metrics["settling_time_s"] < 1200.0
+    # Within 15 % of the paper's 968 s (distributed, scheme I), the criterion of docs/RESULTS.md.
+    assert 0.85 * 968.0 <= metrics["settling_time_s"] <= 1.15 * 968.0, metrics["settling_time_s"]
     assert [e["target"] for e in metrics["colregs"]] == ["A", "B", "C"]
     assert all(e["verdict"] == "compliant" for e in metrics["colregs"]), metrics["colregs"]
     for name in ("plant.mcap", "controller.mcap"):
