@@ -19,6 +19,15 @@ from fmpy.logging import addLoggerProxy
 STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"]
 
 
+# fmpy's logging proxy (`addLoggerProxy`, its logging.so) keeps one process-wide pointer to
+# the last logger it was given, and fmpy's default callbacks go through that proxy too. A
+# MessageLog freed while the pointer still names its logger closure leaves every later FMU
+# that logs (fmpy.simulate_fmu, fmpy.ssp) calling freed memory: a SIGSEGV inside the FMU's
+# fmi2DoStep as soon as it logs a line. Every logger handed to the proxy is kept alive here for
+# the life of the process.
+_PROXIED = []
+
+
 class MessageLog:
     """Collects (status, category, message) tuples from one or more FMU instances."""
 
@@ -31,6 +40,7 @@ class MessageLog:
         self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
         addLoggerProxy(byref(self.callbacks))
+        _PROXIED.append(self)
 
     def _log(self, env, instance, status, category, message):
         entry = (STATUS[status], category.decode(), message.decode("utf-8", "replace"))
