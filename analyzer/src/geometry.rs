@@ -7,7 +7,8 @@
 use std::f64::consts::PI;
 
 pub use towing_model::geometry::{
-    body_to_ned, dist, segment_projection, HullRect, Lane, Polyline, Projection,
+    body_to_ned, crossed_ahead, dist, line_coordinates, segment_projection, HullRect, Lane,
+    Polyline, Projection,
 };
 
 /// A point `[north, east]`, m.
@@ -144,16 +145,6 @@ pub fn range_rate(p_own: P2, v_own: P2, p_target: P2, v_target: P2) -> f64 {
     } else {
         0.0
     }
-}
-
-/// Coordinates of `p` in the frame of a course line through `origin` with direction
-/// `course` (rad from North, clockwise): `(along, across)`, along positive ahead, across
-/// positive to starboard of the line.
-#[must_use]
-pub fn line_coordinates(origin: P2, course: f64, p: P2) -> (f64, f64) {
-    let (s, c) = course.sin_cos();
-    let (dn, de) = (p[0] - origin[0], p[1] - origin[1]);
-    (dn * c + de * s, -dn * s + de * c)
 }
 
 /// Velocity `[north, east]` of a vessel on `course` (rad) at `speed` (m/s).

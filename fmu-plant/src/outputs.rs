@@ -108,18 +108,22 @@ impl Groundings {
     /// The hulls aground in `world`.
     #[must_use]
     pub fn of(world: &World) -> Groundings {
-        let aground = world
-            .bank_excess()
-            .map_or([false; 3], |e| e.map(|x| x > 0.0));
+        Groundings::from_excess(world.bank_excess())
+    }
+
+    /// The hulls aground for the excesses beyond the bank of [`World::bank_excess`].
+    fn from_excess(excess: Option<[f64; 3]>) -> Groundings {
+        let aground = excess.map_or([false; 3], |e| e.map(|x| x > 0.0));
         Groundings { aground }
     }
 
     /// Moves to `world`'s state: the groundings that began (a hull aground now that was
     /// not before), one event each.
     pub fn update(&mut self, world: &World) -> Vec<GroundingEvent> {
-        let now = Groundings::of(world);
+        let excess = world.bank_excess();
+        let now = Groundings::from_excess(excess);
         let mut events = Vec::new();
-        if let Some(excess) = world.bank_excess() {
+        if let Some(excess) = excess {
             for (k, vessel) in [Vessel::Ship, Vessel::Tug1, Vessel::Tug2]
                 .into_iter()
                 .enumerate()

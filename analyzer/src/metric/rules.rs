@@ -44,7 +44,7 @@ use crate::doc::Block;
 use crate::error::Result;
 
 use crate::geometry::{
-    course_velocity, cpa_tcpa, hull_ellipse_clearance, line_coordinates, range_rate,
+    course_velocity, cpa_tcpa, crossed_ahead, hull_ellipse_clearance, line_coordinates, range_rate,
 };
 use crate::rows::VESSELS;
 use crate::colregs::{classify, Situation};
@@ -315,9 +315,7 @@ impl Target {
         // target's own motion moves it across.
         let crossed = crossing
             && prev.is_some_and(|(p_ship, p_psi, p_target)| {
-                let (_, before) = line_coordinates(p_ship, p_psi, p_target);
-                let (along, now) = line_coordinates(p_ship, p_psi, tp);
-                before != 0.0 && before * now <= 0.0 && along > 0.0
+                crossed_ahead(p_ship, p_psi, p_target, tp)
             });
         let beta = relative_bearing(sp, ship.psi, tp);
         let opening = range_rate(sp, ship.vel_n(), tp, course_velocity(o.course, o.speed)) > 0.0;

@@ -304,7 +304,12 @@ struct Part<'a> {
     index: usize,
 }
 
-impl Part<'_> {
+impl<'a> Part<'a> {
+    /// The part of a sequence, tuple, map or struct `walker` is entering.
+    fn of(walker: &'a mut Finite) -> Part<'a> {
+        Part { walker, index: 0 }
+    }
+
     fn element<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), NotFinite> {
         let i = self.index;
         self.index += 1;
@@ -442,22 +447,13 @@ impl<'a> ser::Serializer for &'a mut Finite {
         self.nested(Step::Field(variant), v)
     }
     fn serialize_seq(self, _: Option<usize>) -> Result<Part<'a>, NotFinite> {
-        Ok(Part {
-            walker: self,
-            index: 0,
-        })
+        Ok(Part::of(self))
     }
     fn serialize_tuple(self, _: usize) -> Result<Part<'a>, NotFinite> {
-        Ok(Part {
-            walker: self,
-            index: 0,
-        })
+        Ok(Part::of(self))
     }
     fn serialize_tuple_struct(self, _: &'static str, _: usize) -> Result<Part<'a>, NotFinite> {
-        Ok(Part {
-            walker: self,
-            index: 0,
-        })
+        Ok(Part::of(self))
     }
     fn serialize_tuple_variant(
         self,
@@ -466,22 +462,13 @@ impl<'a> ser::Serializer for &'a mut Finite {
         _: &'static str,
         _: usize,
     ) -> Result<Part<'a>, NotFinite> {
-        Ok(Part {
-            walker: self,
-            index: 0,
-        })
+        Ok(Part::of(self))
     }
     fn serialize_map(self, _: Option<usize>) -> Result<Part<'a>, NotFinite> {
-        Ok(Part {
-            walker: self,
-            index: 0,
-        })
+        Ok(Part::of(self))
     }
     fn serialize_struct(self, _: &'static str, _: usize) -> Result<Part<'a>, NotFinite> {
-        Ok(Part {
-            walker: self,
-            index: 0,
-        })
+        Ok(Part::of(self))
     }
     fn serialize_struct_variant(
         self,
@@ -490,10 +477,7 @@ impl<'a> ser::Serializer for &'a mut Finite {
         _: &'static str,
         _: usize,
     ) -> Result<Part<'a>, NotFinite> {
-        Ok(Part {
-            walker: self,
-            index: 0,
-        })
+        Ok(Part::of(self))
     }
 }
 

@@ -59,6 +59,8 @@ impl Tag {
 /// 2.2.7).
 struct VarIndex {
     by_type: [Vec<(u32, usize)>; 4],
+    /// Positions of the Real outputs, the variables every step checks for finite values.
+    real_outputs: Vec<usize>,
 }
 
 fn type_slot(ty: ValueType) -> usize {
@@ -79,7 +81,14 @@ impl VarIndex {
         for list in &mut by_type {
             list.sort_unstable();
         }
-        VarIndex { by_type }
+        let real_outputs = (desc.variables.iter().enumerate())
+            .filter(|(_, v)| v.causality == Causality::Output && v.value_type() == ValueType::Real)
+            .map(|(pos, _)| pos)
+            .collect();
+        VarIndex {
+            by_type,
+            real_outputs,
+        }
     }
 
     fn position(&self, ty: ValueType, vr: u32) -> Option<usize> {
@@ -155,10 +164,10 @@ impl<M: Fmi2Model> Instance<M> {
     /// usable is `fmi2Discard`), whatever the model computed. A getter's own error is the
     /// master's to see when it reads the variable, not a reason here.
     fn non_finite_output(&self) -> Option<String> {
-        self.desc
-            .variables
+        self.index
+            .real_outputs
             .iter()
-            .filter(|v| v.causality == Causality::Output && v.value_type() == ValueType::Real)
+            .map(|&pos| &self.desc.variables[pos])
             .find_map(|v| match self.model.get_real(v.value_reference) {
                 Ok(x) if !x.is_finite() => Some(format!(
                     "output '{}' (vr {}) is not finite ({x})",

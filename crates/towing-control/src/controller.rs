@@ -288,18 +288,34 @@ impl std::fmt::Display for Fallback {
 pub struct ControllerState {
     guidance: ReferenceSystem,
     optimizer: OptimizerState,
+    carried: Carried,
+}
+
+/// The controller's own part of its [`ControllerState`]: what [`Controller`] carries from
+/// one sample to the next besides the guidance and the optimizer, one field each, held as
+/// one value so that the state is this value, never a field-by-field copy of it.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+struct Carried {
+    /// The command applied last.
     applied: AppliedCommand,
+    /// The previous sample's plans, shifted: the fallback.
     spare_ship: [ShipInput; HORIZON],
     spare_tugs: [[TugInput; HORIZON]; 2],
+    /// Genuine samples left in the spare plan (`H - 1` after a solved sample,
+    /// one less after each fallback; 0: the plan is used up).
     spare_left: usize,
+    /// Tug velocities at the start of the sample and predicted at its end.
     nu_start: [[f64; 3]; 2],
     nu_end: [[f64; 3]; 2],
     fallbacks: u64,
+    /// Per obstacle slot: the ship's heading when an encounter began in which
+    /// the tow may not turn to port ([`TrackingParams::port_turn_margin`]).
     port_turn_anchor: [Option<f64>; MAX_OBSTACLES],
-    /// The reference course of the last sample.
+    /// The reference course of the last sample ([`TrackingParams::course_rate`]);
+    /// `None` before the first sample.
     course: Option<f64>,
     clock: Clock,
-    /// The last sample rested (a measurement describing no tow).
+    /// The last sample rested ([`Rest`]).
     resting: bool,
 }
 
@@ -351,29 +367,11 @@ pub struct Controller {
     solver: Box<dyn Optimizer>,
     inner_k: [[[f64; 3]; 3]; 2],
     thrust_limit: [[f64; 3]; 2],
-    applied: AppliedCommand,
-    /// The previous sample's plans, shifted: the fallback.
-    spare_ship: [ShipInput; HORIZON],
-    spare_tugs: [[TugInput; HORIZON]; 2],
-    /// Genuine samples left in the spare plan (`H - 1` after a solved sample,
-    /// one less after each fallback; 0: the plan is used up).
-    spare_left: usize,
-    /// Tug velocities at the start of the sample and predicted at its end.
-    nu_start: [[f64; 3]; 2],
-    nu_end: [[f64; 3]; 2],
-    fallbacks: u64,
+    /// Everything else the next samples depend on ([`ControllerState`]).
+    carried: Carried,
     mpc_obstacles: [Obstacle; MAX_OBSTACLES],
-    /// Per obstacle slot: the ship's heading when an encounter began in which
-    /// the tow may not turn to port ([`TrackingParams::port_turn_margin`]).
-    port_turn_anchor: [Option<f64>; MAX_OBSTACLES],
-    /// The reference course of the last sample ([`TrackingParams::course_rate`]);
-    /// `None` before the first sample.
-    course: Option<f64>,
-    clock: Clock,
     /// A copy of the last sample's MPC input ([`Controller::last_mpc_input`]).
     last_input: Option<MpcInput>,
-    /// The last sample rested ([`Rest`]).
-    resting: bool,
 }
 
 fn mass_matrix(d: &VesselData) -> [[f64; 3]; 3] {
@@ -422,71 +420,42 @@ impl Controller {
             solver,
             inner_k,
             thrust_limit,
-            // The lines start at their pretension (`min_tension`), straight.
-            applied: AppliedCommand {
-                ship: [f0, f0, 0.0, 0.0],
-                tugs: [[0.0; 3]; 2],
+            carried: Carried {
+                // The lines start at their pretension (`min_tension`), straight.
+                applied: AppliedCommand {
+                    ship: [f0, f0, 0.0, 0.0],
+                    tugs: [[0.0; 3]; 2],
+                },
+                spare_ship: [[0.0; 4]; HORIZON],
+                spare_tugs: [[[0.0; 3]; HORIZON]; 2],
+                spare_left: 0,
+                nu_start: [[0.0; 3]; 2],
+                nu_end: [[0.0; 3]; 2],
+                fallbacks: 0,
+                port_turn_anchor: [None; MAX_OBSTACLES],
+                course: None,
+                clock: Clock {
+                    // sample_time > 0 and finite (checked); at least 1 ns.
+                    sample_ns: ((sample_time * 1e9).round() as i64).max(1),
+                    ..Clock::default()
+                },
+                resting: false,
             },
-            spare_ship: [[0.0; 4]; HORIZON],
-            spare_tugs: [[[0.0; 3]; HORIZON]; 2],
-            spare_left: 0,
-            nu_start: [[0.0; 3]; 2],
-            nu_end: [[0.0; 3]; 2],
-            fallbacks: 0,
             mpc_obstacles: [Obstacle::Circle {
                 centre: [0.0; 2],
                 radius: 1.0,
             }; MAX_OBSTACLES],
-            port_turn_anchor: [None; MAX_OBSTACLES],
-            course: None,
-            clock: Clock {
-                // sample_time > 0 and finite (checked); at least 1 ns.
-                sample_ns: ((sample_time * 1e9).round() as i64).max(1),
-                ..Clock::default()
-            },
             last_input: None,
-            resting: false,
         })
     }
 
-    /// The state to carry over ([`ControllerState`]). The destructuring names every
-    /// field, so a field added to the controller has to be placed in or out of it.
+    /// The state to carry over ([`ControllerState`]).
     #[must_use]
     pub fn snapshot(&self) -> ControllerState {
-        let Controller {
-            config: _,
-            guidance,
-            solver,
-            inner_k: _,
-            thrust_limit: _,
-            applied,
-            spare_ship,
-            spare_tugs,
-            spare_left,
-            nu_start,
-            nu_end,
-            fallbacks,
-            mpc_obstacles: _,
-            port_turn_anchor,
-            course,
-            clock,
-            last_input: _,
-            resting,
-        } = self;
         ControllerState {
-            guidance: guidance.clone(),
-            optimizer: solver.snapshot(),
-            applied: *applied,
-            spare_ship: *spare_ship,
-            spare_tugs: *spare_tugs,
-            spare_left: *spare_left,
-            nu_start: *nu_start,
-            nu_end: *nu_end,
-            fallbacks: *fallbacks,
-            port_turn_anchor: *port_turn_anchor,
-            course: *course,
-            clock: *clock,
-            resting: *resting,
+            guidance: self.guidance.clone(),
+            optimizer: self.solver.snapshot(),
+            carried: self.carried,
         }
     }
 
@@ -499,16 +468,17 @@ impl Controller {
     /// a waypoint outside the route, a plan of another size), named; nothing changes
     /// then.
     pub fn restore(&mut self, state: &ControllerState) -> Result<(), String> {
-        if state.clock.sample_ns != self.clock.sample_ns {
+        let (own, carried) = (&self.carried, &state.carried);
+        if carried.clock.sample_ns != own.clock.sample_ns {
             return Err(format!(
                 "the state's sample time is {} ns, this controller's {} ns",
-                state.clock.sample_ns, self.clock.sample_ns
+                carried.clock.sample_ns, own.clock.sample_ns
             ));
         }
-        if state.spare_left >= HORIZON {
+        if carried.spare_left >= HORIZON {
             return Err(format!(
                 "{} samples left in the spare plan, at most {} possible",
-                state.spare_left,
+                carried.spare_left,
                 HORIZON - 1
             ));
         }
@@ -516,17 +486,7 @@ impl Controller {
         guidance.restore(&state.guidance)?;
         self.solver.restore(&state.optimizer)?;
         self.guidance = guidance;
-        self.applied = state.applied;
-        self.spare_ship = state.spare_ship;
-        self.spare_tugs = state.spare_tugs;
-        self.spare_left = state.spare_left;
-        self.nu_start = state.nu_start;
-        self.nu_end = state.nu_end;
-        self.fallbacks = state.fallbacks;
-        self.port_turn_anchor = state.port_turn_anchor;
-        self.course = state.course;
-        self.clock = state.clock;
-        self.resting = state.resting;
+        self.carried = state.carried;
         Ok(())
     }
 
@@ -539,13 +499,13 @@ impl Controller {
     /// Fallbacks since instantiation.
     #[must_use]
     pub fn fallbacks(&self) -> u64 {
-        self.fallbacks
+        self.carried.fallbacks
     }
 
     /// The command applied in the last sample.
     #[must_use]
     pub fn applied(&self) -> &AppliedCommand {
-        &self.applied
+        &self.carried.applied
     }
 
     /// The input the MPC was given in the last control sample (`None` before
@@ -567,9 +527,9 @@ impl Controller {
         let guided = self.guide(m)?;
         let rest = self.overlap(m).map(|overlap| Rest {
             overlap,
-            first: !self.resting,
+            first: !self.carried.resting,
         });
-        self.resting = rest.is_some();
+        self.carried.resting = rest.is_some();
         let (report, (ship_cmd, tug_cmd, fallback)) = if rest.is_some() {
             (REST_REPORT, self.rest())
         } else {
@@ -578,8 +538,8 @@ impl Controller {
         };
         let prediction = self.prediction(m, fallback.is_none() && rest.is_none());
         for i in 0..2 {
-            self.nu_start[i] = [m.tugs[i][3], m.tugs[i][4], m.tugs[i][5]];
-            self.nu_end[i] = [
+            self.carried.nu_start[i] = [m.tugs[i][3], m.tugs[i][4], m.tugs[i][5]];
+            self.carried.nu_end[i] = [
                 prediction.tugs[i][0][3],
                 prediction.tugs[i][0][4],
                 prediction.tugs[i][0][5],
@@ -605,7 +565,7 @@ impl Controller {
             r_dual: residual(report.r_dual),
             compute_time: start.elapsed().as_secs_f64(),
             fallback,
-            fallbacks: self.fallbacks,
+            fallbacks: self.carried.fallbacks,
             rest,
             heading_floor: guided.heading_floor,
             prediction,
@@ -619,7 +579,7 @@ impl Controller {
         let input = SampleInput {
             ship: m.ship,
             tugs: m.tugs,
-            previous: self.applied,
+            previous: self.carried.applied,
             reference: [guided.reference; HORIZON],
             obstacles: &self.mpc_obstacles[..n_obstacles],
             distance_cost_off,
@@ -659,9 +619,9 @@ impl Controller {
     /// no plan to keep, and the next solved sample starts cold.
     fn rest(&mut self) -> (ShipInput, [TugInput; 2], Option<Fallback>) {
         self.solver.reset();
-        self.spare_left = 0;
+        self.carried.spare_left = 0;
         let (ship, tugs) = self.within_bounds(self.rest_plan());
-        self.applied = AppliedCommand { ship, tugs };
+        self.carried.applied = AppliedCommand { ship, tugs };
         (ship, tugs, None)
     }
 
@@ -744,23 +704,24 @@ impl Controller {
         };
         let shift = |h: usize| (h + 1).min(HORIZON - 1);
         let (ship_cmd, tug_cmd) = if fallback.is_some() {
-            self.fallbacks += 1;
+            self.carried.fallbacks += 1;
             let (s, t) = self.fallback_command();
             self.solver.reset();
-            self.spare_ship = std::array::from_fn(|h| self.spare_ship[shift(h)]);
-            self.spare_tugs =
-                std::array::from_fn(|i| std::array::from_fn(|h| self.spare_tugs[i][shift(h)]));
+            self.carried.spare_ship = std::array::from_fn(|h| self.carried.spare_ship[shift(h)]);
+            self.carried.spare_tugs = std::array::from_fn(|i| {
+                std::array::from_fn(|h| self.carried.spare_tugs[i][shift(h)])
+            });
             (s, t)
         } else {
             // The next sample's spare plan, and the warm start.
-            self.spare_ship = std::array::from_fn(|h| ship_plan[shift(h)]);
-            self.spare_tugs =
+            self.carried.spare_ship = std::array::from_fn(|h| ship_plan[shift(h)]);
+            self.carried.spare_tugs =
                 std::array::from_fn(|i| std::array::from_fn(|h| tug_plans[i][shift(h)]));
-            self.spare_left = HORIZON - 1;
+            self.carried.spare_left = HORIZON - 1;
             self.solver.shift();
             (ship_plan[0], [tug_plans[0][0], tug_plans[1][0]])
         };
-        self.applied = AppliedCommand {
+        self.carried.applied = AppliedCommand {
             ship: ship_cmd,
             tugs: tug_cmd,
         };
@@ -779,21 +740,21 @@ impl Controller {
     /// A refused measurement (the sample's or the inner loop's); nothing changes
     /// then.
     pub fn step(&mut self, t: f64, m: &Measurement) -> Result<Step, StepError> {
-        let start = *self.clock.start.get_or_insert(t);
+        let start = *self.carried.clock.start.get_or_insert(t);
         let now_ns = ((t - start) * 1e9).round() as i64;
         let mut sample = None;
-        if now_ns + SAMPLE_TOLERANCE_NS >= self.clock.next_ns {
+        if now_ns + SAMPLE_TOLERANCE_NS >= self.carried.clock.next_ns {
             let report = self
                 .sample(m)
                 .map_err(|source| StepError::Sample { t, source })?;
-            self.clock.last_ns = now_ns;
-            while self.clock.next_ns <= now_ns + SAMPLE_TOLERANCE_NS {
-                self.clock.next_ns += self.clock.sample_ns;
+            self.carried.clock.last_ns = now_ns;
+            while self.carried.clock.next_ns <= now_ns + SAMPLE_TOLERANCE_NS {
+                self.carried.clock.next_ns += self.carried.clock.sample_ns;
             }
-            self.clock.samples += 1;
+            self.carried.clock.samples += 1;
             sample = Some(report);
         }
-        let elapsed = (now_ns - self.clock.last_ns) as f64 * 1e-9;
+        let elapsed = (now_ns - self.carried.clock.last_ns) as f64 * 1e-9;
         let command = self
             .command_at(elapsed, m)
             .map_err(|source| StepError::Command { t, source })?;
@@ -803,13 +764,13 @@ impl Controller {
     /// Sets the time of the first sample instant (s); by default the time of
     /// the first [`Controller::step`].
     pub fn set_start_time(&mut self, t0: f64) {
-        self.clock.start = Some(t0);
+        self.carried.clock.start = Some(t0);
     }
 
     /// Control samples run by [`Controller::step`] so far.
     #[must_use]
     pub fn samples(&self) -> u64 {
-        self.clock.samples
+        self.carried.clock.samples
     }
 
     /// The command at `elapsed` seconds after the last sample, with the tugs'
@@ -819,7 +780,7 @@ impl Controller {
     /// A non-finite tug velocity, by name.
     pub fn command_at(&self, elapsed: f64, m: &Measurement) -> Result<Command, MeasurementError> {
         let s = (elapsed / self.config.tuning.prediction.sample_time).clamp(0.0, 1.0);
-        let mut tug_thrust = self.applied.tugs;
+        let mut tug_thrust = self.carried.applied.tugs;
         for i in 0..2 {
             for c in 0..3 {
                 let value = m.tugs[i][3 + c];
@@ -831,7 +792,8 @@ impl Controller {
                 }
             }
             let err: [f64; 3] = std::array::from_fn(|c| {
-                self.nu_start[i][c] + s * (self.nu_end[i][c] - self.nu_start[i][c])
+                self.carried.nu_start[i][c]
+                    + s * (self.carried.nu_end[i][c] - self.carried.nu_start[i][c])
                     - m.tugs[i][3 + c]
             });
             for ((tau, k), l) in tug_thrust[i]
@@ -845,7 +807,7 @@ impl Controller {
         }
         Ok(Command {
             tug_thrust,
-            tension: [self.applied.ship[0], self.applied.ship[1]],
+            tension: [self.carried.applied.ship[0], self.carried.applied.ship[1]],
         })
     }
 
@@ -925,21 +887,17 @@ impl Controller {
         let far = los > 0.0 && range > los;
         let wanted = if far { dy.atan2(dx) } else { goal[2] };
         let step = t.tracking.course_rate * t.prediction.sample_time;
-        let mut course = match self.course {
-            Some(c) if step > 0.0 => wrap_angle(c + wrap_angle(wanted - c).clamp(-step, step)),
-            // The first sample turns from the ship's own heading.
-            None if step > 0.0 => {
-                let psi = ship[2];
-                wrap_angle(psi + wrap_angle(wanted - psi).clamp(-step, step))
-            }
-            _ => wanted,
+        // The first sample turns from the ship's own heading.
+        let mut course = if step > 0.0 {
+            turn_towards(self.carried.course.unwrap_or(ship[2]), wanted, step)
+        } else {
+            wanted
         };
         let lead = t.tracking.course_lead;
         if lead > 0.0 {
-            let psi = ship[2];
-            course = wrap_angle(psi + wrap_angle(course - psi).clamp(-lead, lead));
+            course = turn_towards(ship[2], course, lead);
         }
-        self.course = Some(course);
+        self.carried.course = Some(course);
         if far {
             let (s, c) = course.sin_cos();
             let reach = match t.tracking.lookahead {
@@ -988,16 +946,16 @@ impl Controller {
                     )
                 );
             if !binding {
-                self.port_turn_anchor[k] = None;
+                self.carried.port_turn_anchor[k] = None;
                 continue;
             }
             // Ratchet: a starboard alteration is not taken back before the
             // situation ends (Rule 8(d): until the target is past and clear).
-            let anchor = match self.port_turn_anchor[k] {
+            let anchor = match self.carried.port_turn_anchor[k] {
                 Some(a) if wrap_angle(a - psi) > 0.0 => a,
                 _ => psi,
             };
-            self.port_turn_anchor[k] = Some(anchor);
+            self.carried.port_turn_anchor[k] = Some(anchor);
             // Relative to the current heading, so that wrapping cannot matter.
             let limit = wrap_angle(anchor - psi) - self.config.tuning.tracking.port_turn_margin;
             floor = Some(floor.map_or(limit, |f: f64| f.max(limit)));
@@ -1016,12 +974,12 @@ impl Controller {
     /// command goes to rest ([`Controller::rest_plan`]); the tow then drifts to a
     /// stop.
     fn fallback_command(&mut self) -> (ShipInput, [TugInput; 2]) {
-        let have_spare = self.spare_left > 0;
-        self.spare_left = self.spare_left.saturating_sub(1);
+        let have_spare = self.carried.spare_left > 0;
+        self.carried.spare_left = self.carried.spare_left.saturating_sub(1);
         let wanted = if have_spare {
             (
-                self.spare_ship[0],
-                [self.spare_tugs[0][0], self.spare_tugs[1][0]],
+                self.carried.spare_ship[0],
+                [self.carried.spare_tugs[0][0], self.carried.spare_tugs[1][0]],
             )
         } else {
             self.rest_plan()
@@ -1046,7 +1004,7 @@ impl Controller {
         let p = &self.config.tuning.ship;
         let ts = self.config.tuning.prediction.sample_time;
         let (tension_step, angle_step) = (p.tension_rate * ts, p.angle_rate * ts);
-        let prev = self.applied.ship;
+        let prev = self.carried.applied.ship;
         let mut ship = [0.0; 4];
         for i in 0..2 {
             let lo = (prev[i] - tension_step).max(p.min_tension);
@@ -1127,13 +1085,19 @@ impl Controller {
             }
         } else {
             let model: &ShipModel = self.solver.ship_model();
-            let rollout = model.rollout::<HORIZON>(&m.ship, &[self.applied.ship; HORIZON]);
+            let rollout = model.rollout::<HORIZON>(&m.ship, &[self.carried.applied.ship; HORIZON]);
             if rollout.iter().flatten().all(|v| v.is_finite()) {
                 out.ship = rollout;
             }
         }
         out
     }
+}
+
+/// The angle `to`, or the one at most `max` (rad, > 0) from `from` towards it, wrapped to
+/// `(-pi, pi]`.
+fn turn_towards(from: f64, to: f64, max: f64) -> f64 {
+    wrap_angle(from + wrap_angle(to - from).clamp(-max, max))
 }
 
 fn finite_or(v: f64, default: f64) -> f64 {

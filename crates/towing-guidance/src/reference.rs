@@ -178,14 +178,16 @@ pub struct Sighting {
 
 impl Sighting {
     /// True when `target_now` lies on the other side of this sighting's heading line
-    /// than the target did, and ahead of the ship.
+    /// than the target did, and ahead of the ship ([`towing_model::geometry::crossed_ahead`],
+    /// the analyzer's test too).
     #[must_use]
     pub fn crossed_ahead(&self, target_now: [f64; 2]) -> bool {
-        let (s, c) = self.ship.psi.sin_cos();
-        let side = |p: [f64; 2]| -(p[0] - self.ship.x) * s + (p[1] - self.ship.y) * c;
-        let along = (target_now[0] - self.ship.x) * c + (target_now[1] - self.ship.y) * s;
-        let before = side(self.target);
-        before != 0.0 && before * side(target_now) <= 0.0 && along > 0.0
+        towing_model::geometry::crossed_ahead(
+            self.ship.position(),
+            self.ship.psi,
+            self.target,
+            target_now,
+        )
     }
 }
 
@@ -254,7 +256,13 @@ pub fn assess_obstacle(
             .is_some_and(|p| p.crossed_ahead(obstacle.centre()));
     let past_and_clear = encounter.zip(situation).is_some_and(|(enc, situation)| {
         (context.cleared && !s.colregs.rule17.give_way_failed(&enc.cpa))
-            || past_and_clear(params, tow, &vessels, obstacle, (situation, crossed))
+            || past_and_clear(
+                params,
+                tow,
+                &vessels,
+                obstacle,
+                (situation, crossed, enc.bearing),
+            )
     });
     let manoeuvre = match (
         detected && alteration_allowed && !past_and_clear,
@@ -290,8 +298,9 @@ pub fn assess_obstacle(
 /// - where it is: in a crossing (any situation but head-on and the two overtaking ones)
 ///   the target has crossed the ship's heading line ahead of her by its own motion
 ///   (`crossed`, [`Sighting::crossed_ahead`]); in any situation it may instead be abaft
-///   the ship's beam (`|beta| > 90 deg`). A head-on or overtaking target moves along the
-///   tow's track, not across it, so only the second applies to it;
+///   the ship's beam (`bearing`, the encounter's `beta`: `|beta| > 90 deg`). A head-on or
+///   overtaking target moves along the tow's track, not across it, so only the second
+///   applies to it;
 /// - and for every vessel of the tow (position `p`, length `l`) the range is opening,
 ///   `(p_target - p) . (v_target - v_ship) > 0`, and the range-equivalent distance
 ///   exceeds the eq. (14) safe range `L + a_j + d_S0` plus `release_margin`. The tugs
@@ -302,7 +311,7 @@ fn past_and_clear(
     tow: &TowState,
     vessels: &[(TowVessel, [f64; 2], f64); 3],
     obstacle: &ActiveObstacle,
-    (situation, crossed): (Situation, bool),
+    (situation, crossed, bearing): (Situation, bool, f64),
 ) -> bool {
     let ActiveObstacle::Vessel(target) = obstacle else {
         return false;
@@ -312,9 +321,7 @@ fn past_and_clear(
         situation,
         Situation::HeadOn | Situation::Overtaking | Situation::BeingOvertaken
     );
-    let beta =
-        crate::geometry::relative_bearing(tow.ship.x, tow.ship.y, tow.ship.psi, target.centre);
-    let abaft = beta.abs() > std::f64::consts::FRAC_PI_2;
+    let abaft = bearing.abs() > std::f64::consts::FRAC_PI_2;
     if !(abaft || (crossed && !along_track)) {
         return false;
     }

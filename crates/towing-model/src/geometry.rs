@@ -25,6 +25,28 @@ pub fn dist(a: Point, b: Point) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }
 
+/// Coordinates of `p` in the frame of a course line through `origin` with direction
+/// `course` (rad from North, clockwise): `(along, across)`, along positive ahead, across
+/// positive to starboard of the line.
+#[must_use]
+pub fn line_coordinates(origin: Point, course: f64, p: Point) -> (f64, f64) {
+    let (s, c) = course.sin_cos();
+    let (dn, de) = (p[0] - origin[0], p[1] - origin[1]);
+    (dn * c + de * s, -dn * s + de * c)
+}
+
+/// COLREGS Rule 8(d), a crossing target *past*: between two samples the target went from
+/// `before` to `now` across the heading line of own ship's pose `(origin, course)` at the
+/// earlier sample, held still over the step (so neither own ship's turn nor its sideways
+/// motion can make the crossing), and lies ahead of that pose. The one test of the
+/// guidance (`towing_guidance::Sighting`) and of the analyzer's Rule 8 check.
+#[must_use]
+pub fn crossed_ahead(origin: Point, course: f64, before: Point, now: Point) -> bool {
+    let (_, side_before) = line_coordinates(origin, course, before);
+    let (along, side_now) = line_coordinates(origin, course, now);
+    side_before != 0.0 && side_before * side_now <= 0.0 && along > 0.0
+}
+
 /// Body point `(bx forward, by starboard)` of a vessel at `(x, y, psi)`, in NED
 /// (the rotation `R(psi)` of Fossen 2021, eq. (2.18), in the plane).
 #[must_use]
