@@ -43,9 +43,8 @@ def target_dir():
 
 
 @pytest.fixture(scope="module")
-def recorder():
-    subprocess.run(["cargo", "build", "--release", "-p", "towing-control", "--example", "record_centralized"],
-                   cwd=ROOT, check=True)
+def recorder(fmus):
+    """Built by the fixture's `cargo xtask fmu` (the one workspace build every command uses)."""
     return target_dir() / "release" / "examples" / "record_centralized"
 
 

@@ -42,7 +42,7 @@ def xtask_campaign(file, out, *options):
 
 @pytest.fixture(scope="module")
 def analyzer(fmus):
-    subprocess.run(["cargo", "build", "--release", "-p", "analyzer"], cwd=ROOT, check=True)
+    """Built by the fixture's `cargo xtask fmu` (the one workspace build every command uses)."""
     return target_dir() / "release" / "analyzer"
 
 

@@ -256,7 +256,7 @@ def rust(systems):
         key = (coupling, initial_inputs)
         if key not in runs:
             p = subprocess.run(
-                ["cargo", "run", "--quiet", "--release", "-p", "e2e-tests", "--example", "closed_loop_csv", "--",
+                [str(target_dir() / "release" / "examples" / "closed_loop_csv"),
                  "--plant", str(systems["plant"]), "--controller", str(systems["controller"]), "--coupling", coupling,
                  "--initial-inputs", initial_inputs, "--stop-time", str(STOP_TIME), "--step", str(STEP)],
                 cwd=ROOT, capture_output=True, text=True, timeout=3600,

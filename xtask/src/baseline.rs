@@ -6,7 +6,7 @@
 //! Steps, each named when it fails:
 //!
 //! 1. the Python environment with casadi (`masters/requirements.txt`, [`python::ensure_env`]);
-//! 2. the recorder, `cargo build --release -p towing-control --example record_centralized`;
+//! 2. the recorder, `examples/record_centralized` of towing-control, from the one workspace build;
 //! 3. `record_centralized record`: the closed loop, the recorded inputs
 //!    (`DIR/recorded.json`) and ours replayed and timed (`DIR/ours.json`);
 //! 4. `benches/baseline/casadi_centralized.py solve`: IPOPT on the same inputs
@@ -15,7 +15,7 @@
 //!    (`DIR/evaluated.json`);
 //! 6. `casadi_centralized.py report`: the table (also `DIR/summary.json`).
 
-use crate::{cargo, fail, progress, python, root, run, target_dir, Result};
+use crate::{fail, progress, python, root, run, target_dir, Result};
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -68,17 +68,7 @@ fn parse(args: &[String]) -> Result<Options> {
 pub fn bench_baseline(args: &[String]) -> Result<()> {
     let o = parse(args)?;
     let python = python::ensure_env()?;
-    run(
-        "build the recorder",
-        cargo().args([
-            "build",
-            "--release",
-            "-p",
-            "towing-control",
-            "--example",
-            "record_centralized",
-        ]),
-    )?;
+    crate::build_release()?;
     let recorder = target_dir().join("release/examples/record_centralized");
     let script = root().join("benches/baseline/casadi_centralized.py");
     let dir = &o.out;

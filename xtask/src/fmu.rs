@@ -4,9 +4,10 @@
 //! crate's model description binary, committed under `modelDescription/`, and packaged from
 //! there; packaging refuses to run when the committed file differs from the generated one.
 
-use crate::{cargo, fail, output, progress, root, run, target_dir, FmuCrate, Result, FMUS};
+use crate::{build_release, fail, output, progress, root, target_dir, FmuCrate, Result, FMUS};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 use zip::write::SimpleFileOptions;
 
 /// Generated documents of one FMU, as printed by its model description binary.
@@ -17,24 +18,11 @@ struct Generated {
     parameters: String,
 }
 
+/// Runs the FMU crate's model description binary of the last [`build_release`].
 fn generate(fmu: &FmuCrate) -> Result<Generated> {
     let step = format!("generate model description of {}", fmu.model_identifier);
-    let run_example = |what: &str| {
-        output(
-            &step,
-            cargo().args([
-                "run",
-                "--quiet",
-                "--release",
-                "--package",
-                fmu.package,
-                "--bin",
-                fmu.description_bin,
-                "--",
-                what,
-            ]),
-        )
-    };
+    let bin = target_dir().join("release").join(fmu.description_bin);
+    let run_example = |what: &str| output(&step, Command::new(&bin).arg(what));
     Ok(Generated {
         xml: run_example("xml")?,
         html: run_example("html")?,
@@ -56,6 +44,7 @@ pub fn write_model_descriptions() -> Result<()> {
     let doc_path = root().join("docs/interface.md");
     let mut doc = std::fs::read_to_string(&doc_path)
         .or_else(|e| fail(STEP, format!("{}: {e}", doc_path.display())))?;
+    build_release()?;
     for fmu in FMUS {
         let generated = generate(fmu)?;
         let path = committed_path(fmu);
@@ -98,12 +87,7 @@ fn splice(doc: &str, id: &str, what: &str, table: &str) -> std::result::Result<S
 /// `cargo xtask fmu`: builds and packages every FMU; returns the paths of the .fmu files.
 pub fn package_all() -> Result<Vec<PathBuf>> {
     let mut packages = Vec::new();
-    let mut build = cargo();
-    build.args(["build", "--release"]);
-    for fmu in FMUS {
-        build.args(["--package", fmu.package]);
-    }
-    run("build FMU libraries", &mut build)?;
+    build_release()?;
     for fmu in FMUS {
         packages.push(package(fmu)?);
     }

@@ -156,6 +156,18 @@ pub fn cargo() -> Command {
     Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
 }
 
+/// The one release build every command uses: the whole workspace, every target. One package
+/// selection means one resolved feature set (cargo unifies features over the selected
+/// packages and, once a test, bench or example is built, their dev-dependencies), so the
+/// demo, the FMU packaging, the campaigns and `cargo test --workspace --release` share every
+/// compiled dependency, polars above all, instead of compiling it once per selection.
+pub fn build_release() -> Result<()> {
+    run(
+        "release build (workspace, all targets)",
+        cargo().args(["build", "--release", "--workspace", "--all-targets"]),
+    )
+}
+
 const USAGE: &str = "usage: cargo xtask <command>
 
 commands:

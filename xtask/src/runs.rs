@@ -11,7 +11,7 @@
 //! DIR/report.html, report.md, metrics.json, ...   the analyzer's report
 //! ```
 
-use crate::{cargo, fail, fmu, progress, python, root, run, target_dir, Result};
+use crate::{fail, fmu, progress, python, root, run, target_dir, Result};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -93,10 +93,6 @@ impl Tools {
         };
         let plant = find("TowingPlant")?;
         let controller = find("TowingController")?;
-        run(
-            "build the analyzer",
-            cargo().args(["build", "--release", "--package", "analyzer"]),
-        )?;
         let analyzer = target_dir().join("release/analyzer");
         if !analyzer.is_file() {
             return fail(
