@@ -13,9 +13,9 @@
 //! | 3200 + 10 (h - 1) + j | predicted positions after sample h = 1..=3 (j: ship x, y, tug1 x, y, tug2 x, y) |
 
 use fmi2_slave::description::{Variable, VariableKind};
+use fmi2_slave::LibraryLazy;
 use fmi2_slave::ValueType;
 use std::fmt;
-use std::sync::LazyLock;
 use towing_control::{Command, SampleReport};
 use towing_guidance::{Role, Situation};
 use towing_interface::types::real_kind;
@@ -507,7 +507,7 @@ fn predictions() -> Vec<Diagnostic> {
 }
 
 /// Every diagnostic output, in model-description order, built once.
-pub static DIAGNOSTICS: LazyLock<Vec<Diagnostic>> = LazyLock::new(|| {
+pub static DIAGNOSTICS: LibraryLazy<Vec<Diagnostic>> = LibraryLazy::new(|| {
     let mut v = solver();
     v.extend(guidance());
     v.extend(colregs());

@@ -23,8 +23,8 @@
 
 use crate::diagnostics::{self, DIAGNOSTICS};
 use fmi2_slave::description::{ModelDescription, VariableKind};
+use fmi2_slave::LibraryLazy;
 use fmi2_slave::ValueType;
-use std::sync::LazyLock;
 use towing_control::params::PARAMETERS;
 use towing_interface::codec::{
     ContractVariable, ModelVariable, Towline, TowlineField, VariableTable,
@@ -108,7 +108,7 @@ impl ModelVariable for ControllerVariable {
 }
 
 /// The controller's variables by value reference, built once.
-pub static VARIABLES: LazyLock<VariableTable<ControllerVariable>> = LazyLock::new(|| {
+pub static VARIABLES: LibraryLazy<VariableTable<ControllerVariable>> = LibraryLazy::new(|| {
     use ControllerVariable as V;
     let contract = ContractVariable::all()
         .filter(|c| !matches!(c, ContractVariable::Towline(_, TowlineField::Slack)))
@@ -147,8 +147,9 @@ pub const INFO: ModelInfo = ModelInfo {
     fmu_state: true,
 };
 
-/// The controller's model description, built once.
-pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(build);
+/// The controller's model description, built once and freed when a host unloads the
+/// library ([`LibraryLazy`]; issue 15).
+pub static DESCRIPTION: LibraryLazy<ModelDescription> = LibraryLazy::new(build);
 
 /// The `modelDescription.xml` of the FMU: [`DESCRIPTION`] as XML. It declares
 /// `canGetAndSetFMUstate` and `canSerializeFMUstate` true (`ControllerState`; the

@@ -17,8 +17,8 @@
 //! into a [`PlantVariable`] and match on it.
 
 use fmi2_slave::description::{ModelDescription, VariableKind};
+use fmi2_slave::LibraryLazy;
 use fmi2_slave::ValueType;
-use std::sync::LazyLock;
 use towing_interface::codec::{
     ContractVariable, ModelVariable, Towline, TowlineField, VariableTable,
 };
@@ -83,7 +83,7 @@ impl ModelVariable for PlantVariable {
 }
 
 /// The plant's variables by value reference, built once.
-pub static VARIABLES: LazyLock<VariableTable<PlantVariable>> = LazyLock::new(|| {
+pub static VARIABLES: LibraryLazy<VariableTable<PlantVariable>> = LibraryLazy::new(|| {
     let session = (0..session::PARAMETERS.len()).map(PlantVariable::Session);
     let own = (0..PARAMETERS.len()).map(PlantVariable::Parameter);
     let outputs = (0..OUTPUTS.len()).map(PlantVariable::Output);
@@ -112,8 +112,9 @@ pub const INFO: ModelInfo = ModelInfo {
 /// The model identifier (binary name).
 pub const MODEL_IDENTIFIER: &str = "TowingPlant";
 
-/// The plant's model description, built once.
-pub static DESCRIPTION: LazyLock<ModelDescription> = LazyLock::new(build);
+/// The plant's model description, built once and freed when a host unloads the library
+/// ([`LibraryLazy`]; issue 15).
+pub static DESCRIPTION: LibraryLazy<ModelDescription> = LibraryLazy::new(build);
 
 fn build() -> ModelDescription {
     let mut v = parameters::variables(&INFO, PARAMETERS);

@@ -1,10 +1,10 @@
 //! The model description (FMI 2.0 chapter 2.2) and its `modelDescription.xml` writer.
 //!
-//! Safe code only. A model crate builds one [`ModelDescription`] (usually in a
-//! `std::sync::LazyLock`) from a table of [`Variable`]s; the slave layer uses the same value
-//! at run time (value-reference lookup, causality checks, log categories, GUID), and the
-//! packaging step writes [`ModelDescription::to_xml`] into the FMU. The FMU never reads its
-//! own XML at run time.
+//! Safe code only. A model crate builds one [`ModelDescription`] (in a
+//! [`LibraryLazy`](crate::LibraryLazy) static, freed when a host unloads the library) from a
+//! table of [`Variable`]s; the slave layer uses the same value at run time (value-reference
+//! lookup, causality checks, log categories, GUID), and the packaging step writes
+//! [`ModelDescription::to_xml`] into the FMU. The FMU never reads its own XML at run time.
 //!
 //! What the writer guarantees (checked by [`ModelDescription::validate`] and the unit
 //! tests), following FMI 2.0 sections 2.2.1 to 2.2.8 and what fmpy's and fmi-rs's validators

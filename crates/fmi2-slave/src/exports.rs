@@ -29,6 +29,7 @@ use crate::ffi::*;
 use crate::logger::{status_category, to_cstring, Logger};
 use crate::serial::{self, ns_to_s, LayerState};
 use crate::state::{CallState, Func};
+use crate::unload;
 use crate::uri::resource_dir_from_uri;
 use crate::{Fmi2Model, InstanceContext, StepContext, StepOutcome};
 
@@ -432,6 +433,9 @@ pub unsafe fn instantiate<M: Fmi2Model>(
         Ok(Some(n)) => *n,
         _ => "",
     };
+    // Counted before the model description is touched: the library's destructor frees the
+    // `LibraryLazy` values only when no instance is alive or being made.
+    unload::instance_begun();
     let result = catch_unwind(AssertUnwindSafe(|| {
         instantiate_checked::<M>(
             callback,
@@ -443,6 +447,9 @@ pub unsafe fn instantiate<M: Fmi2Model>(
             logging_on != FMI2_FALSE,
         )
     }));
+    if !matches!(result, Ok(Some(_))) {
+        unload::instance_ended();
+    }
     match result {
         Ok(Some(instance)) => Box::into_raw(instance).cast(),
         Ok(None) => ptr::null_mut(),
@@ -553,30 +560,34 @@ pub unsafe fn free_instance<M: Fmi2Model>(c: Fmi2Component) {
         inst.logger.info("logCalls", Func::FreeInstance.name());
     }
     inst.tag.magic = DEAD_MAGIC;
-    // SAFETY: `c` came from `Box::into_raw` in `fmi2Instantiate` (tag checked) and is
-    // freed exactly once (the tag is now dead).
-    let boxed = unsafe { Box::from_raw(c.cast::<Instance<M>>()) };
-    let Instance {
-        mut model, logger, ..
-    } = *boxed;
-    if let Err(payload) = catch_unwind(AssertUnwindSafe(|| model.release(&logger))) {
-        let text = panic_text(payload.as_ref());
-        drop_payload(payload);
-        logger.log(
-            Fmi2Status::Fatal,
-            status_category(Fmi2Status::Fatal),
-            &format!("fmi2FreeInstance: panic while releasing the model: {text}"),
-        );
+    {
+        // SAFETY: `c` came from `Box::into_raw` in `fmi2Instantiate` (tag checked) and is
+        // freed exactly once (the tag is now dead).
+        let boxed = unsafe { Box::from_raw(c.cast::<Instance<M>>()) };
+        let Instance {
+            mut model, logger, ..
+        } = *boxed;
+        if let Err(payload) = catch_unwind(AssertUnwindSafe(|| model.release(&logger))) {
+            let text = panic_text(payload.as_ref());
+            drop_payload(payload);
+            logger.log(
+                Fmi2Status::Fatal,
+                status_category(Fmi2Status::Fatal),
+                &format!("fmi2FreeInstance: panic while releasing the model: {text}"),
+            );
+        }
+        if let Err(payload) = catch_unwind(AssertUnwindSafe(move || drop(model))) {
+            let text = panic_text(payload.as_ref());
+            drop_payload(payload);
+            logger.log(
+                Fmi2Status::Fatal,
+                status_category(Fmi2Status::Fatal),
+                &format!("fmi2FreeInstance: panic while dropping the model: {text}"),
+            );
+        }
     }
-    if let Err(payload) = catch_unwind(AssertUnwindSafe(move || drop(model))) {
-        let text = panic_text(payload.as_ref());
-        drop_payload(payload);
-        logger.log(
-            Fmi2Status::Fatal,
-            status_category(Fmi2Status::Fatal),
-            &format!("fmi2FreeInstance: panic while dropping the model: {text}"),
-        );
-    }
+    // Everything of the instance is dropped: it no longer holds the library's tables.
+    unload::instance_ended();
 }
 
 // ---------------------------------------------------------------------------------------

@@ -32,7 +32,8 @@
 //!   tolerance, a nanosecond clock `i64` and a step counter), the model value, the
 //!   [`Logger`], the static model description with a value-reference index built once,
 //!   the stored instantiation context (for `fmi2Reset`) and the `CString` storage behind
-//!   `fmi2GetString`. No global mutable state and no thread-locals: instances are
+//!   `fmi2GetString`. No thread-locals and no global mutable state besides the count of live
+//!   instances and the list of [`LibraryLazy`] values to free on unload: instances are
 //!   independent and may live on different threads.
 //! * **Time** — the clock counts whole nanoseconds since the start time; `fmi2DoStep`
 //!   checks the master's communication point `tc` against it with tolerance
@@ -58,6 +59,11 @@
 //!   category (from [`ModelDescription::log_categories`]) is enabled.
 //! * **Model description** ([`description`]) — the XML writer, the deterministic GUID and
 //!   the consistency check used at instantiation.
+//! * **Unloading** ([`LibraryLazy`]) — what the library builds once (model description,
+//!   variable tables) lives in `LibraryLazy` statics, freed by the library's destructor when
+//!   a host unloads it (`dlclose`) with no instance alive, so load/unload cycles do not
+//!   leak (issue 15); kept at process exit. [`export_fmi2!`] places the constructor and
+//!   destructor.
 
 #![warn(missing_docs)]
 
@@ -70,6 +76,7 @@ mod logger;
 mod serial;
 mod state;
 pub mod testing;
+mod unload;
 mod uri;
 
 use std::path::Path;
@@ -82,12 +89,14 @@ pub use description::{
 pub use ffi::Fmi2Status;
 pub use logger::Logger;
 pub use state::CallState;
+pub use unload::LibraryLazy;
 pub use uri::resource_dir_from_uri;
 
 /// Implementation detail of [`export_fmi2!`]; not a stable API.
 #[doc(hidden)]
 pub mod __export {
     pub use crate::exports::*;
+    pub use crate::unload::{on_load, on_unload};
 }
 
 /// What `fmi2Instantiate` (and `fmi2Reset`) hands to [`Fmi2Model::instantiate`].
@@ -151,7 +160,8 @@ pub enum StepOutcome {
 /// every variable unchanged. If the model's own setter returns `Err` for element `k`, the
 /// elements before `k` have been applied and the instance is in the `error` state.
 pub trait Fmi2Model: Clone + Send + Sized + 'static {
-    /// The model description; keep it in a `std::sync::LazyLock`. Validated at every
+    /// The model description; keep it in a [`LibraryLazy`] static (not a `LazyLock`, whose
+    /// value a host's `dlclose` would leak: see [`LibraryLazy`]). Validated at every
     /// instantiation; its GUID must match the one the master passes.
     fn description() -> &'static ModelDescription;
 
@@ -249,6 +259,19 @@ macro_rules! export_fmi2 {
             fn assert_model<M: $crate::Fmi2Model>() {}
             assert_model::<$model>();
         };
+
+        /// The library's constructor: lets the destructor tell process exit from unload.
+        #[allow(unsafe_code)]
+        #[used]
+        #[cfg_attr(target_os = "linux", link_section = ".init_array")]
+        static __FMI2_SLAVE_ON_LOAD: extern "C" fn() = $crate::__export::on_load;
+
+        /// The library's destructor: frees the `LibraryLazy` values when a host unloads the
+        /// library (issue 15; see `fmi2_slave::LibraryLazy`).
+        #[allow(unsafe_code)]
+        #[used]
+        #[cfg_attr(target_os = "linux", link_section = ".fini_array")]
+        static __FMI2_SLAVE_ON_UNLOAD: extern "C" fn() = $crate::__export::on_unload;
 
         /// FMI 2.0 `fmi2GetTypesPlatform`: `"default"`.
         ///

@@ -13,9 +13,9 @@
 //! appear; [`StateComponent::of`] and [`ObstacleField::of`] read the Real fields the
 //! variables name.
 
+use fmi2_slave::LibraryLazy;
 use std::collections::HashMap;
 use std::fmt;
-use std::sync::LazyLock;
 
 use fmi2_slave::ValueType;
 use towing_model::{ObstacleKind, ObstacleSlot, VesselState, MAX_OBSTACLES};
@@ -244,8 +244,8 @@ pub enum ContractVariable {
 }
 
 /// Every contract variable by value reference, built once.
-static CONTRACT: LazyLock<VariableTable<ContractVariable>> =
-    LazyLock::new(|| VariableTable::new("the interface contract", ContractVariable::all()));
+static CONTRACT: LibraryLazy<VariableTable<ContractVariable>> =
+    LibraryLazy::new(|| VariableTable::new("the interface contract", ContractVariable::all()));
 
 impl ContractVariable {
     /// Every contract variable, in value-reference order.
@@ -382,7 +382,7 @@ impl ModelVariable for ContractVariable {
 }
 
 /// One FMU's variables by (FMI type, value reference), built once from the list of its
-/// variables (an FMU keeps it in a `LazyLock`). The FMU's getters and setters decode every
+/// variables (an FMU keeps it in a `fmi2_slave::LibraryLazy`). The FMU's getters and setters decode every
 /// reference through it.
 #[derive(Debug)]
 pub struct VariableTable<V> {
