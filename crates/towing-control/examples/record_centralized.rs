@@ -505,6 +505,7 @@ fn input_from(v: &Value, k: usize) -> Res<MpcInput> {
             .as_u64()
             .ok_or_else(|| format!("{what}.distance_cost_off: not an unsigned integer"))?,
         heading_floor,
+        waterway: None,
     };
     Ok(MpcInput::of(&input))
 }

@@ -6,6 +6,7 @@
 use std::sync::Arc;
 
 use towing_guidance::{GuidanceParams, GuidanceSettings, Route};
+use towing_model::geometry::{HullRect, Lane, Polyline};
 use towing_model::registry::{Enumeration, Item};
 use towing_model::{HullDynamics, HullModel, Scenario};
 use towing_mpc::{
@@ -395,6 +396,26 @@ impl ControllerConfig {
         } else {
             self.tuning.hull
         }
+    }
+
+    /// The waterway the MPC keeps every hull inside ([`towing_mpc::Waterway`],
+    /// `docs/controller-design.md`, "The waterway"): the scenario's route with the half
+    /// width guidance uses, and per vessel (ship, tug 1, tug 2) its hull's corner radius
+    /// plus the 0.1 m the clearance rows' `d_min` allow for the motion within a sample
+    /// (`docs/assumptions.md`). `None` without a waterway.
+    #[must_use]
+    pub fn waterway(&self) -> Option<(Lane, [f64; 3])> {
+        let s = &self.scenario;
+        let half_width = self.guidance().waterway_half_width?;
+        let margin = |d: &towing_model::VesselData| HullRect::of(d).radius() + 0.1;
+        Some((
+            Lane::new(Polyline::of_route(&s.route), half_width),
+            [
+                margin(&s.ship_data),
+                margin(&s.tug_data[0]),
+                margin(&s.tug_data[1]),
+            ],
+        ))
     }
 
     /// The reference system's settings: the tuning's, with the waterway and the

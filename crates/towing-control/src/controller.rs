@@ -37,13 +37,14 @@ use towing_guidance::{
     body_to_ned, role, ActiveObstacle, GuidanceOutput, GuidanceParams, ReferenceSystem, Role,
     Situation, TowState,
 };
+use towing_model::geometry::Lane;
 use towing_model::{
     wrap_angle, ObstacleKind, ObstacleSlot, Pose, VesselData, VesselState, World, MAX_OBSTACLES,
 };
 use towing_mpc::{
     Admm, AdmmBuildError, AppliedCommand, Budget, Centralized, FormationMap, MpcReport, Obstacle,
     Optimizer, OptimizerState, PredictionHull, QpOutcome, SampleInput, ShipInput, ShipModel,
-    ShipMpc, TugInput, TugModel, TugMpc, HORIZON,
+    ShipMpc, TugInput, TugModel, TugMpc, Waterway, HORIZON,
 };
 
 use crate::config::{Architecture, ControllerConfig, InnerLoopParams};
@@ -370,6 +371,8 @@ pub struct Controller {
     /// Everything else the next samples depend on ([`ControllerState`]).
     carried: Carried,
     mpc_obstacles: [Obstacle; MAX_OBSTACLES],
+    /// The waterway of the MPC ([`ControllerConfig::waterway`]).
+    waterway: Option<(Lane, [f64; 3])>,
     /// A copy of the last sample's MPC input ([`Controller::last_mpc_input`]).
     last_input: Option<MpcInput>,
 }
@@ -414,7 +417,9 @@ impl Controller {
         });
         let f0 = config.tuning.ship.min_tension;
         let sample_time = config.tuning.prediction.sample_time;
+        let waterway = config.waterway();
         Ok(Controller {
+            waterway,
             config,
             guidance,
             solver,
@@ -584,6 +589,10 @@ impl Controller {
             obstacles: &self.mpc_obstacles[..n_obstacles],
             distance_cost_off,
             heading_floor: guided.heading_floor,
+            waterway: (self.waterway.as_ref()).map(|(lane, margin)| Waterway {
+                lane,
+                margin: *margin,
+            }),
         };
         self.last_input = Some(MpcInput::of(&input));
         let budget_s = self.config.tuning.sample_time_budget;

@@ -8,7 +8,9 @@
 //! for the MPC and the heading floor) and hands it to the distributed or the
 //! centralized solver. [`Controller::last_mpc_input`](crate::Controller::last_mpc_input)
 //! returns a copy of it, so that exactly the same problem can be solved again by
-//! another solver or by a fresh instance of the same one.
+//! another solver or by a fresh instance of the same one. The waterway's bank rows are
+//! not part of the copy (`as_sample_input` gives open water): the baseline's scenario,
+//! the paper's, has no waterway section.
 
 use towing_model::MAX_OBSTACLES;
 use towing_mpc::{AppliedCommand, Obstacle, SampleInput, ShipState, TugState, HORIZON};
@@ -82,6 +84,7 @@ impl MpcInput {
             obstacles: self.obstacles(),
             distance_cost_off: self.distance_cost_off,
             heading_floor: self.heading_floor,
+            waterway: None,
         }
     }
 }
@@ -116,6 +119,7 @@ mod tests {
             obstacles: &obstacles,
             distance_cost_off: 0b10,
             heading_floor: Some(0.2),
+            waterway: None,
         };
         let owned = MpcInput::of(&input);
         let back = owned.as_sample_input();

@@ -48,6 +48,7 @@ fn bench(c: &mut Criterion) {
             obstacles: &obstacles,
             distance_cost_off: 0,
             heading_floor: None,
+            waterway: None,
         };
         let mut admm = Admm::from_scenario(
             &scenario,
@@ -92,6 +93,7 @@ fn bench(c: &mut Criterion) {
             obstacles,
             distance_cost_off: 0,
             heading_floor: None,
+            waterway: None,
         };
         let mut central = Centralized::from_scenario(
             &scenario,

@@ -39,6 +39,8 @@ fn bench(c: &mut Criterion) {
         rho: 1.0,
         obstacles: &obstacles,
         distance_cost_off: 0,
+        own_ship: None,
+        waterway: None,
     };
     let tug_plan = [[1.0, 0.0, 0.0]; HORIZON];
     c.bench_function("tug_scp_step", |b| {
@@ -77,6 +79,7 @@ fn bench(c: &mut Criterion) {
         obstacles: &obstacles,
         distance_cost_off: 0,
         heading_floor: None,
+        waterway: None,
     };
     let ship_plan = [[0.5, 1.0, 0.0, 0.0]; HORIZON];
     c.bench_function("ship_scp_step", |b| {

@@ -44,7 +44,7 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 use towing_model::{HullModel, ParamError, Scenario};
 
-use crate::costs::angle_difference;
+use crate::costs::{angle_difference, Waterway};
 use crate::engine::{Budget, ScpReport, ScpState};
 use crate::formation::FormationMap;
 use crate::obstacle::Obstacle;
@@ -210,6 +210,9 @@ pub struct SampleInput<'a> {
     /// no turn to port while giving way or standing on
     /// ([`crate::ShipMpcParams::port_turn_weight`]); `None`: no such limit.
     pub heading_floor: Option<f64>,
+    /// The waterway every vessel of the tow keeps inside ([`Waterway`]); `None`: open
+    /// water.
+    pub waterway: Option<Waterway<'a>>,
 }
 
 /// Residuals and tolerances of one iteration (per tug).
@@ -560,6 +563,7 @@ impl Core<'_> {
                 obstacles: input.obstacles,
                 distance_cost_off: input.distance_cost_off,
                 heading_floor: input.heading_floor,
+                waterway: input.waterway,
             });
             last_steps = [steps[0], steps[1], ship];
             failed_steps += last_steps.iter().filter(|r| !r.qp.is_usable()).count();
@@ -610,6 +614,7 @@ impl Core<'_> {
         tug_states: &[TugState; 2],
         side: &ShipSide,
     ) -> ([ScpReport; 2], [Poses; 2]) {
+        let own_ship = Some(self.formation.ship_obstacle(&input.ship, &side.states));
         let data = |i: usize| TugStepData {
             state: tug_states[i],
             pulls: std::array::from_fn(|h| {
@@ -625,6 +630,8 @@ impl Core<'_> {
             rho: self.settings.rho,
             obstacles: input.obstacles,
             distance_cost_off: input.distance_cost_off,
+            own_ship,
+            waterway: input.waterway,
         };
         self.tug2.start(&data(1));
         let first = self.tug1.step(&data(0));

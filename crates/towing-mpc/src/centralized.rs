@@ -73,7 +73,9 @@ use serde::{Deserialize, Serialize};
 use towing_model::{HullModel, ParamError, Scenario};
 
 use crate::admm::{AdmmBuildError, SampleInput};
-use crate::costs::{angle_difference, obstacle_terms, ship_stage_terms, thrust_rate_terms};
+use crate::costs::{
+    angle_difference, bank_terms, obstacle_terms, ship_stage_terms, thrust_rate_terms,
+};
 use crate::engine::{
     Block, BlockMut, Budget, InputSpace, Merit, PairRows, QuadModel, RowSet, Scp, ScpReport,
     ScpSettings, ScpState, SlotRows, Subproblem,
@@ -312,12 +314,14 @@ pub struct CentralLinearised {
 }
 
 /// The centralized problem's soft rows: the consensus rows, then the clearance
-/// rows of the ship, tug 1 and tug 2.
+/// rows of the ship, tug 1 and tug 2, the ship's motion limits and the bank rows of the
+/// three vessels.
 #[derive(Debug, Clone)]
 pub struct CentralRows {
     consensus: PairRows,
     clearance: [SlotRows; 3],
     motion: SlotRows,
+    bank: [SlotRows; 3],
 }
 
 impl RowSet for CentralRows {
@@ -325,11 +329,13 @@ impl RowSet for CentralRows {
         std::iter::once(Block::Pairs(&self.consensus))
             .chain(self.clearance.iter().map(Block::Slots))
             .chain(std::iter::once(Block::Slots(&self.motion)))
+            .chain(self.bank.iter().map(Block::Slots))
     }
     fn blocks_mut(&mut self) -> impl Iterator<Item = BlockMut<'_>> {
         std::iter::once(BlockMut::Pairs(&mut self.consensus))
             .chain(self.clearance.iter_mut().map(BlockMut::Slots))
             .chain(std::iter::once(BlockMut::Slots(&mut self.motion)))
+            .chain(self.bank.iter_mut().map(BlockMut::Slots))
     }
 }
 
@@ -418,9 +424,13 @@ impl CentralProblem {
         soft: Option<&mut CentralRows>,
         input: &SampleInput<'_>,
     ) {
-        let (clearance, motion) = match soft {
-            Some(r) => (Some(&mut r.clearance[0]), Some(&mut r.motion)),
-            None => (None, None),
+        let (clearance, motion, bank) = match soft {
+            Some(r) => (
+                Some(&mut r.clearance[0]),
+                Some(&mut r.motion),
+                Some(&mut r.bank[0]),
+            ),
+            None => (None, None, None),
         };
         let sp = &self.ship_params;
         ship_stage_terms(
@@ -450,6 +460,11 @@ impl CentralProblem {
             &rows[0],
             &rows[1],
         );
+        if let Some(waterway) = &input.waterway {
+            let single = sp.clearance.single();
+            let p = [x[0], x[1]];
+            bank_terms(quad, waterway, 0, &single, bank, h, p, &rows[0], &rows[1]);
+        }
     }
 
     /// The cost terms of `traj` reached with `plan`; with `lin` the model rows
@@ -536,6 +551,21 @@ impl CentralProblem {
                     &rows[0],
                     &rows[1],
                 );
+                if let Some(waterway) = &input.waterway {
+                    let bank = rows_out.as_deref_mut().map(|r| &mut r.bank[1 + i]);
+                    let (p, single) = ([g[0], g[1]], tp.clearance.single());
+                    bank_terms(
+                        quad,
+                        waterway,
+                        1 + i,
+                        &single,
+                        bank,
+                        h,
+                        p,
+                        &rows[0],
+                        &rows[1],
+                    );
+                }
                 out.tugs[i] += quad.value - start;
             }
         }
@@ -617,6 +647,11 @@ impl Subproblem for CentralProblem {
                 self.tug_params.clearance.rows(PER_STEP, TUG[1]),
             ],
             motion: self.ship_params.motion.rows(PER_STEP, SHIP),
+            bank: [
+                self.ship_params.clearance.single().rows(PER_STEP, SHIP),
+                self.tug_params.clearance.single().rows(PER_STEP, TUG[0]),
+                self.tug_params.clearance.single().rows(PER_STEP, TUG[1]),
+            ],
         }
     }
 

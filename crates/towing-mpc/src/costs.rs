@@ -17,6 +17,7 @@ use crate::ship::{ShipInput, ShipState};
 use crate::ship_mpc::ShipMpcParams;
 use crate::tug::TugInput;
 use crate::HORIZON;
+use towing_model::geometry::Lane;
 
 /// `a - b` wrapped to `(-pi, pi]` (heading differences).
 #[must_use]
@@ -86,6 +87,60 @@ impl ClearanceParams {
             self.penalty,
             self.max_slack,
         )
+    }
+
+    /// The same row kind with one slot: a vessel's row about its own ship
+    /// ([`crate::FormationMap::ship_obstacle`]) or about the bank ([`bank_terms`]).
+    #[must_use]
+    pub fn single(&self) -> ClearanceParams {
+        ClearanceParams {
+            max_obstacles: 1,
+            ..*self
+        }
+    }
+}
+
+/// The waterway as a constraint of the MPC (`docs/controller-design.md`, "The waterway"):
+/// the scenario's lane (route and half width) and, per vessel (ship, tug 1, tug 2), the
+/// clearance its reference point keeps from the bank: the hull's corner radius (every
+/// corner then lies inside, [`Lane::hull_excess`] `<= 0`) plus a margin for the motion
+/// within a sample.
+#[derive(Debug, Clone, Copy)]
+pub struct Waterway<'a> {
+    /// The lane.
+    pub lane: &'a Lane,
+    /// Clearance from the bank of the ship, tug 1 and tug 2 (m).
+    pub margin: [f64; 3],
+}
+
+/// The bank row of vessel `vessel` (0 ship, 1 tug 1, 2 tug 2) at its predicted position
+/// `pos` after sample `h`: `b(p) = half_width - d(p) >= margin - s`, `d` the distance from
+/// the route ([`Lane::distance_and_gradient`]), linearised like the clearance rows
+/// (`b + grad b . (row_x, row_y) du >= margin - s`, `grad b = -grad d`), with the exact L1
+/// penalty of `params` on the slack (Nocedal and Wright 2006, section 17.2) in the true
+/// cost too.
+#[allow(clippy::too_many_arguments)] // the pieces of one row; as obstacle_terms
+pub(crate) fn bank_terms<const N: usize>(
+    quad: &mut QuadModel,
+    waterway: &Waterway<'_>,
+    vessel: usize,
+    params: &ClearanceParams,
+    rows: Option<&mut SlotRows>,
+    h: usize,
+    pos: [f64; 2],
+    row_x: &[f64; N],
+    row_y: &[f64; N],
+) {
+    let (d, grad) = waterway.lane.distance_and_gradient(pos);
+    let clearance = waterway.lane.half_width - d;
+    let margin = waterway.margin[vessel];
+    quad.value += params.penalty * (margin - clearance).max(0.0);
+    if let Some(r) = rows {
+        let mut row = [0.0; N];
+        for (v, (a, b)) in row.iter_mut().zip(row_x.iter().zip(row_y)) {
+            *v = -(grad[0] * a + grad[1] * b);
+        }
+        r.record(h, 0, clearance, margin, &row);
     }
 }
 

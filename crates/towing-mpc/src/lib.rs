@@ -114,7 +114,7 @@ pub use admm::{
 pub use centralized::{
     Centralized, CentralizedReport, CentralizedSettings, CentralizedState, CostBreakdown,
 };
-pub use costs::{angle_difference, ClearanceParams, MotionLimits};
+pub use costs::{angle_difference, ClearanceParams, MotionLimits, Waterway};
 pub use engine::{Budget, Merit, Scp, ScpReport, ScpSettings, ScpState, Subproblem, TrustRegion};
 pub use formation::FormationMap;
 pub use hull::{JacobianMethod, PredictionHull};

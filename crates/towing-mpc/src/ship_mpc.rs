@@ -31,7 +31,8 @@
 use nalgebra::Matrix6x4;
 
 use crate::costs::{
-    angle_difference, obstacle_terms, ship_stage_terms, ClearanceParams, MotionLimits,
+    angle_difference, bank_terms, obstacle_terms, ship_stage_terms, ClearanceParams, MotionLimits,
+    Waterway,
 };
 use crate::engine::{
     Block, BlockMut, Channel, InputSpace, QuadModel, RowSet, Scp, ScpSettings, SlotRows,
@@ -238,6 +239,8 @@ pub struct ShipStepData<'a> {
     /// The lowest heading the ship may take over the horizon (rad), from
     /// COLREGS: no turn to port while the tow gives way or stands on.
     pub heading_floor: Option<f64>,
+    /// The waterway ([`crate::SampleInput::waterway`]).
+    pub waterway: Option<Waterway<'a>>,
 }
 
 /// The coordination problem (module docs).
@@ -258,21 +261,29 @@ pub struct ShipLinearised {
     states: [ShipState; HORIZON],
 }
 
-/// The coordination problem's soft rows: the clearance rows and the motion limits.
+/// The coordination problem's soft rows: the clearance rows, the motion limits and the
+/// bank.
 #[derive(Debug, Clone)]
 pub struct ShipRows {
     clearance: SlotRows,
     motion: SlotRows,
+    bank: SlotRows,
 }
 
 impl RowSet for ShipRows {
     fn blocks(&self) -> impl Iterator<Item = Block<'_>> {
-        [Block::Slots(&self.clearance), Block::Slots(&self.motion)].into_iter()
+        [
+            Block::Slots(&self.clearance),
+            Block::Slots(&self.motion),
+            Block::Slots(&self.bank),
+        ]
+        .into_iter()
     }
     fn blocks_mut(&mut self) -> impl Iterator<Item = BlockMut<'_>> {
         [
             BlockMut::Slots(&mut self.clearance),
             BlockMut::Slots(&mut self.motion),
+            BlockMut::Slots(&mut self.bank),
         ]
         .into_iter()
     }
@@ -334,6 +345,7 @@ impl Subproblem for ShipProblem {
         ShipRows {
             clearance: self.params.clearance.rows(4, ALL_VESSELS),
             motion: self.params.motion.rows(4, ALL_VESSELS),
+            bank: self.params.clearance.single().rows(4, ALL_VESSELS),
         }
     }
 
@@ -505,6 +517,19 @@ fn accumulate(
             &rows[0],
             &rows[1],
         );
+        if let Some(waterway) = &data.waterway {
+            bank_terms(
+                quad,
+                waterway,
+                0,
+                &params.clearance,
+                soft.as_deref_mut().map(|r| &mut r.bank),
+                h,
+                [x[0], x[1]],
+                &rows[0],
+                &rows[1],
+            );
+        }
     }
 }
 
@@ -549,6 +574,7 @@ mod tests {
             obstacles: &[],
             distance_cost_off: 0,
             heading_floor: None,
+            waterway: None,
         }
     }
 
@@ -655,6 +681,42 @@ mod tests {
             assert!(with < 1e-3, "{reference:?}: {with} m/s beyond the limits");
             assert!(without > 5e-3, "{reference:?}: {without} m/s without them");
         }
+    }
+
+    /// The ship at the edge of its lane (its clearance from the bank just the margin) and a
+    /// reference beyond the bank: without the bank rows the plan moves her out; with them
+    /// every predicted position keeps the margin (to the slack the exact penalty leaves).
+    #[test]
+    fn the_bank_rows_keep_the_ship_inside_the_waterway() {
+        use towing_model::geometry::{Lane, Polyline};
+        let margin = 0.744;
+        // The route runs North 0.25 m to port of the ship: clearance = half width - 0.25.
+        let lane = Lane::new(
+            Polyline::new(vec![[-10.0, -0.25], [10.0, -0.25]]).unwrap(),
+            0.25 + margin,
+        );
+        let beyond = |waterway: Option<Waterway<'_>>| {
+            let mut mpc = ship_mpc();
+            let mut data = data_at_rest(&mpc, [1.0, 3.0, 0.0], 0.0);
+            data.waterway = waterway;
+            for _ in 0..40 {
+                assert!(mpc.step(&data).qp.is_usable());
+            }
+            mpc.predicted()
+                .iter()
+                .map(|x| lane.excess([x[0], x[1]]) + margin)
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
+        let waterway = Waterway {
+            lane: &lane,
+            margin: [margin, 0.608, 0.608],
+        };
+        let (with, without) = (beyond(Some(waterway)), beyond(None));
+        assert!(with < 1e-3, "{with} m beyond the margin");
+        assert!(
+            without > 5e-3,
+            "{without} m beyond the margin without the rows"
+        );
     }
 
     /// A reference to port turns the ship to port; a heading floor at the

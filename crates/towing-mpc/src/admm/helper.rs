@@ -19,11 +19,13 @@ use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+use crate::costs::Waterway;
 use crate::engine::ScpReport;
 use crate::obstacle::Obstacle;
 use crate::tug::{TowlinePull, TugState};
 use crate::tug_mpc::{TugMpc, TugStepData};
 use crate::HORIZON;
+use towing_model::geometry::Lane;
 
 /// A tug's predicted poses `g_i` of one iteration.
 pub(crate) type Poses = [[f64; 3]; HORIZON];
@@ -54,6 +56,9 @@ struct Job {
     rho: f64,
     obstacles: Vec<Obstacle>,
     distance_cost_off: u64,
+    own_ship: Option<Obstacle>,
+    /// The lane (cloned into the kept buffer) and the margins of the sample's waterway.
+    waterway: Option<(Lane, [f64; 3])>,
 }
 
 impl Job {
@@ -66,6 +71,14 @@ impl Job {
         self.obstacles.clear();
         self.obstacles.extend_from_slice(d.obstacles);
         self.distance_cost_off = d.distance_cost_off;
+        self.own_ship = d.own_ship;
+        match (&mut self.waterway, d.waterway) {
+            (Some((lane, margin)), Some(w)) => {
+                lane.clone_from(w.lane);
+                *margin = w.margin;
+            }
+            (kept, w) => *kept = w.map(|w| (w.lane.clone(), w.margin)),
+        }
     }
 
     fn data(&self) -> TugStepData<'_> {
@@ -77,6 +90,11 @@ impl Job {
             rho: self.rho,
             obstacles: &self.obstacles,
             distance_cost_off: self.distance_cost_off,
+            own_ship: self.own_ship,
+            waterway: self.waterway.as_ref().map(|(lane, margin)| Waterway {
+                lane,
+                margin: *margin,
+            }),
         }
     }
 }

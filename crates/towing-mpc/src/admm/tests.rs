@@ -57,6 +57,7 @@ fn paper_input(obstacles: &[Obstacle]) -> SampleInput<'_> {
         obstacles,
         distance_cost_off: 0,
         heading_floor: None,
+        waterway: None,
     }
 }
 
@@ -145,6 +146,7 @@ fn plant_like_next<'a>(a: &Admm, input: &SampleInput<'a>, r: &AdmmReport) -> Sam
         obstacles: input.obstacles,
         distance_cost_off: input.distance_cost_off,
         heading_floor: None,
+        waterway: None,
     }
 }
 
