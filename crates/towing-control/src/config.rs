@@ -402,9 +402,15 @@ impl ControllerConfig {
     /// `docs/controller-design.md`, "The waterway"): the scenario's route with the half
     /// width guidance uses, and per vessel (ship, tug 1, tug 2) its hull's corner radius
     /// plus the 0.1 m the clearance rows' `d_min` allow for the motion within a sample
-    /// (`docs/assumptions.md`). `None` without a waterway.
+    /// (`docs/assumptions.md`). `None` without a waterway, and in scheme III: the paper's
+    /// distance-cost-only baseline keeps the paper's formulation, which has no bank (its
+    /// reference is the unaltered route, and only wide swings clear the hazards; held
+    /// inside the bank it stalls between hazard a and the bank, `docs/RESULTS.md`).
     #[must_use]
     pub fn waterway(&self) -> Option<(Lane, [f64; 3])> {
+        if !self.tuning.scheme.alters() {
+            return None;
+        }
         let s = &self.scenario;
         let half_width = self.guidance().waterway_half_width?;
         let margin = |d: &towing_model::VesselData| HullRect::of(d).radius() + 0.1;

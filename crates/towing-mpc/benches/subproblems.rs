@@ -39,7 +39,6 @@ fn bench(c: &mut Criterion) {
         rho: 1.0,
         obstacles: &obstacles,
         distance_cost_off: 0,
-        own_ship: None,
         waterway: None,
     };
     let tug_plan = [[1.0, 0.0, 0.0]; HORIZON];

@@ -614,7 +614,6 @@ impl Core<'_> {
         tug_states: &[TugState; 2],
         side: &ShipSide,
     ) -> ([ScpReport; 2], [Poses; 2]) {
-        let own_ship = Some(self.formation.ship_obstacle(&input.ship, &side.states));
         let data = |i: usize| TugStepData {
             state: tug_states[i],
             pulls: std::array::from_fn(|h| {
@@ -630,7 +629,6 @@ impl Core<'_> {
             rho: self.settings.rho,
             obstacles: input.obstacles,
             distance_cost_off: input.distance_cost_off,
-            own_ship,
             waterway: input.waterway,
         };
         self.tug2.start(&data(1));

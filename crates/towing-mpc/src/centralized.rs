@@ -461,9 +461,9 @@ impl CentralProblem {
             &rows[1],
         );
         if let Some(waterway) = &input.waterway {
-            let single = sp.clearance.single();
+            let params = sp.clearance.bank(sp.waterway_rows);
             let p = [x[0], x[1]];
-            bank_terms(quad, waterway, 0, &single, bank, h, p, &rows[0], &rows[1]);
+            bank_terms(quad, waterway, 0, &params, bank, h, p, &rows[0], &rows[1]);
         }
     }
 
@@ -553,12 +553,12 @@ impl CentralProblem {
                 );
                 if let Some(waterway) = &input.waterway {
                     let bank = rows_out.as_deref_mut().map(|r| &mut r.bank[1 + i]);
-                    let (p, single) = ([g[0], g[1]], tp.clearance.single());
+                    let (p, params) = ([g[0], g[1]], tp.clearance.bank(tp.waterway_rows));
                     bank_terms(
                         quad,
                         waterway,
                         1 + i,
-                        &single,
+                        &params,
                         bank,
                         h,
                         p,
@@ -648,9 +648,21 @@ impl Subproblem for CentralProblem {
             ],
             motion: self.ship_params.motion.rows(PER_STEP, SHIP),
             bank: [
-                self.ship_params.clearance.single().rows(PER_STEP, SHIP),
-                self.tug_params.clearance.single().rows(PER_STEP, TUG[0]),
-                self.tug_params.clearance.single().rows(PER_STEP, TUG[1]),
+                (self
+                    .ship_params
+                    .clearance
+                    .bank(self.ship_params.waterway_rows))
+                .rows(PER_STEP, SHIP),
+                (self
+                    .tug_params
+                    .clearance
+                    .bank(self.tug_params.waterway_rows))
+                .rows(PER_STEP, TUG[0]),
+                (self
+                    .tug_params
+                    .clearance
+                    .bank(self.tug_params.waterway_rows))
+                .rows(PER_STEP, TUG[1]),
             ],
         }
     }

@@ -89,12 +89,13 @@ impl ClearanceParams {
         )
     }
 
-    /// The same row kind with one slot: a vessel's row about its own ship
-    /// ([`crate::FormationMap::ship_obstacle`]) or about the bank ([`bank_terms`]).
+    /// The same row kind for the bank ([`bank_terms`]): one slot when `on`, none
+    /// otherwise (a problem without a waterway keeps exactly the QP it had before the
+    /// bank rows existed).
     #[must_use]
-    pub fn single(&self) -> ClearanceParams {
+    pub fn bank(&self, on: bool) -> ClearanceParams {
         ClearanceParams {
-            max_obstacles: 1,
+            max_obstacles: usize::from(on),
             ..*self
         }
     }

@@ -14,21 +14,7 @@ use nalgebra::Matrix3x4;
 use towing_model::towline::formation_pose;
 use towing_model::{ParamError, Scenario, VesselData};
 
-use crate::obstacle::Obstacle;
 use crate::ship::{ShipInput, ShipState};
-use crate::HORIZON;
-
-/// The ellipse through the corners of `vessel`'s `L x B` rectangle (semi-axes `L / sqrt 2`,
-/// `B / sqrt 2`) at `centre`, heading `psi`, moving by `drift` per sample.
-fn hull_ellipse(vessel: &VesselData, centre: [f64; 2], psi: f64, drift: [f64; 2]) -> Obstacle {
-    Obstacle::Ellipse {
-        centre,
-        semi_major: vessel.length * std::f64::consts::FRAC_1_SQRT_2,
-        semi_minor: vessel.width.min(vessel.length) * std::f64::consts::FRAC_1_SQRT_2,
-        orientation: psi,
-        drift,
-    }
-}
 
 /// Desired tug poses from the ship's pose and towing angles (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,20 +60,6 @@ impl FormationMap {
             &scenario.tug_data,
             scenario.towline_desired_length,
         )
-    }
-
-    /// The ship's hull as the tugs' local problems keep clear of it (`docs/controller-design.md`,
-    /// "The tow's own hulls"): the ellipse through the corners of the ship's `L x B`
-    /// rectangle (semi-axes `L / sqrt 2`, `B / sqrt 2`, the smallest ellipse of the hull's
-    /// aspect that contains it) at the ship's present pose `ship`, heading held, moving by
-    /// the mean displacement per sample of the coordination's predicted trajectory
-    /// `predicted` (the constant-velocity motion [`Obstacle::after`] predicts).
-    #[must_use]
-    pub fn ship_obstacle(&self, ship: &ShipState, predicted: &[ShipState; HORIZON]) -> Obstacle {
-        let last = predicted[HORIZON - 1];
-        let k = HORIZON as f64;
-        let drift = [(last[0] - ship[0]) / k, (last[1] - ship[1]) / k];
-        hull_ellipse(&self.ship, [ship[0], ship[1]], ship[2], drift)
     }
 
     /// Desired pose `[x, y, psi]` of the tug on towline `line` (0 = tug 1, 1 =

@@ -110,6 +110,10 @@ pub struct ShipMpcParams {
     /// Soft limits on the predicted drift angle, sternway and speed
     /// ([`MotionLimits`]). Not in the paper (`docs/assumptions.md`).
     pub motion: MotionLimits,
+    /// Bank rows ([`crate::Waterway`], one per sample) built into the problem; `false`
+    /// (the default) builds none. The controller sets it when its configuration has a
+    /// waterway.
+    pub waterway_rows: bool,
 }
 
 impl Default for ShipMpcParams {
@@ -138,6 +142,7 @@ impl Default for ShipMpcParams {
             clearance: ClearanceParams::with_min_distance(0.75),
             weight_port_turn: 100.0,
             motion: MotionLimits::default(),
+            waterway_rows: false,
         }
     }
 }
@@ -345,7 +350,9 @@ impl Subproblem for ShipProblem {
         ShipRows {
             clearance: self.params.clearance.rows(4, ALL_VESSELS),
             motion: self.params.motion.rows(4, ALL_VESSELS),
-            bank: self.params.clearance.single().rows(4, ALL_VESSELS),
+            bank: (self.params.clearance)
+                .bank(self.params.waterway_rows)
+                .rows(4, ALL_VESSELS),
         }
     }
 
@@ -696,7 +703,10 @@ mod tests {
             0.25 + margin,
         );
         let beyond = |waterway: Option<Waterway<'_>>| {
-            let mut mpc = ship_mpc();
+            let mut mpc = ship_mpc_with(ShipMpcParams {
+                waterway_rows: true,
+                ..ShipMpcParams::default()
+            });
             let mut data = data_at_rest(&mpc, [1.0, 3.0, 0.0], 0.0);
             data.waterway = waterway;
             for _ in 0..40 {

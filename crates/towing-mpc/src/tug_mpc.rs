@@ -65,6 +65,8 @@ pub struct TugMpcParams {
     /// Hard clearance rows (default `d_min = 0.6 m`, about half a TitoNeri plus
     /// a margin).
     pub clearance: ClearanceParams,
+    /// Bank rows built into the problem ([`crate::ShipMpcParams::waterway_rows`]).
+    pub waterway_rows: bool,
 }
 
 impl Default for TugMpcParams {
@@ -81,6 +83,7 @@ impl Default for TugMpcParams {
             scp: ScpSettings::default(),
             distance: DistanceCost::default(),
             clearance: ClearanceParams::with_min_distance(0.6),
+            waterway_rows: false,
         }
     }
 }
@@ -130,12 +133,6 @@ pub struct TugStepData<'a> {
     pub obstacles: &'a [Obstacle],
     /// Obstacles left out of the distance cost ([`crate::SampleInput::distance_cost_off`]).
     pub distance_cost_off: u64,
-    /// The tow's own ship as the coordination predicts it
-    /// ([`crate::FormationMap::ship_obstacle`]), kept at the clearance distance by a row of
-    /// its own and no distance cost: the tug works next to it, its line keeps it at the
-    /// formation's distance, and only a tug swinging onto the hull must be stopped.
-    /// `None`: no such row (a tug alone).
-    pub own_ship: Option<Obstacle>,
     /// The waterway ([`crate::SampleInput::waterway`]).
     pub waterway: Option<Waterway<'a>>,
 }
@@ -157,28 +154,20 @@ pub struct TugLinearised {
     states: [TugState; HORIZON],
 }
 
-/// A tug problem's soft rows: the clearance rows of the obstacles and of the tow's own
-/// ship, and the bank.
+/// A tug problem's soft rows: the clearance rows and the bank.
 #[derive(Debug, Clone)]
 pub struct TugRows {
     clearance: SlotRows,
-    own_ship: SlotRows,
     bank: SlotRows,
 }
 
 impl RowSet for TugRows {
     fn blocks(&self) -> impl Iterator<Item = Block<'_>> {
-        [
-            Block::Slots(&self.clearance),
-            Block::Slots(&self.own_ship),
-            Block::Slots(&self.bank),
-        ]
-        .into_iter()
+        [Block::Slots(&self.clearance), Block::Slots(&self.bank)].into_iter()
     }
     fn blocks_mut(&mut self) -> impl Iterator<Item = BlockMut<'_>> {
         [
             BlockMut::Slots(&mut self.clearance),
-            BlockMut::Slots(&mut self.own_ship),
             BlockMut::Slots(&mut self.bank),
         ]
         .into_iter()
@@ -230,8 +219,9 @@ impl Subproblem for TugProblem {
     fn rows(&self) -> TugRows {
         TugRows {
             clearance: self.params.clearance.rows(3, ALL_VESSELS),
-            own_ship: self.params.clearance.single().rows(3, ALL_VESSELS),
-            bank: self.params.clearance.single().rows(3, ALL_VESSELS),
+            bank: (self.params.clearance)
+                .bank(self.params.waterway_rows)
+                .rows(3, ALL_VESSELS),
         }
     }
 
@@ -334,7 +324,7 @@ fn accumulate(
     mut slots: Option<&mut TugRows>,
     data: &TugStepData<'_>,
 ) {
-    let single = params.clearance.single();
+    let bank = params.clearance.bank(params.waterway_rows);
     let (wp, wv) = params.state_weights();
     let w3 = params.weight_distance;
     let mut rows = [[0.0; N]; 6];
@@ -368,27 +358,12 @@ fn accumulate(
             &rows[0],
             &rows[1],
         );
-        if let Some(ship) = &data.own_ship {
-            obstacle_terms(
-                quad,
-                std::slice::from_ref(ship),
-                1,
-                &params.distance,
-                w3,
-                &single,
-                slots.as_deref_mut().map(|r| &mut r.own_ship),
-                h,
-                [x[0], x[1]],
-                &rows[0],
-                &rows[1],
-            );
-        }
         if let Some(waterway) = &data.waterway {
             bank_terms(
                 quad,
                 waterway,
                 vessel,
-                &single,
+                &bank,
                 slots.as_deref_mut().map(|r| &mut r.bank),
                 h,
                 [x[0], x[1]],
@@ -404,7 +379,7 @@ mod tests {
     use super::*;
     use towing_model::{HullModel, Scenario};
 
-    use crate::{FormationMap, PredictionParams};
+    use crate::PredictionParams;
 
     fn tug_mpc() -> TugMpc {
         let scenario = Scenario::paper().unwrap();
@@ -428,7 +403,6 @@ mod tests {
             rho: 1.0,
             obstacles,
             distance_cost_off: 0,
-            own_ship: None,
             waterway: None,
         }
     }
@@ -555,47 +529,6 @@ mod tests {
         let d_min = TugMpcParams::default().clearance.min_distance;
         let free = run(0);
         let kept = run(4);
-        assert!(free < d_min - 0.05, "{free}");
-        assert!(kept >= d_min - 1e-3, "{kept}");
-    }
-
-    /// A reference across the tow's own ship (a towing angle swung through the hull): the
-    /// own-ship row keeps the tug's plan at `d_min` from the hull ellipse, with no distance
-    /// cost of its own; without the ship in the data the plan runs onto the hull.
-    #[test]
-    fn the_own_ship_row_keeps_the_tug_off_the_hull() {
-        let scenario = Scenario::paper().unwrap();
-        let ship = FormationMap::from_scenario(&scenario)
-            .unwrap()
-            .ship_obstacle(
-                &[1.4, 0.0, 1.5, 0.0, 0.0, 0.0],
-                &[[1.4, 0.0, 1.5, 0.0, 0.0, 0.0]; HORIZON],
-            );
-        let run = |own_ship: Option<Obstacle>| {
-            let model = TugModel::from_scenario(
-                &scenario,
-                1,
-                HullModel::NonlinearDamping,
-                PredictionParams::default(),
-            )
-            .unwrap();
-            let mut mpc = TugMpc::new(model, TugMpcParams::default()).unwrap();
-            let mut data = data_ahead(&[]);
-            data.reference = [[1.5, 0.0, 0.0]; HORIZON];
-            data.own_ship = own_ship;
-            for _ in 0..40 {
-                let report = mpc.step(&data);
-                assert!(report.qp.is_usable(), "{report:?}");
-                assert!(within_bounds(&mpc));
-            }
-            mpc.predicted()
-                .iter()
-                .map(|x| ship.distance([x[0], x[1]]).0)
-                .fold(f64::INFINITY, f64::min)
-        };
-        let d_min = TugMpcParams::default().clearance.min_distance;
-        let free = run(None);
-        let kept = run(Some(ship));
         assert!(free < d_min - 0.05, "{free}");
         assert!(kept >= d_min - 1e-3, "{kept}");
     }

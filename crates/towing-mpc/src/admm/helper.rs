@@ -56,7 +56,6 @@ struct Job {
     rho: f64,
     obstacles: Vec<Obstacle>,
     distance_cost_off: u64,
-    own_ship: Option<Obstacle>,
     /// The lane (cloned into the kept buffer) and the margins of the sample's waterway.
     waterway: Option<(Lane, [f64; 3])>,
 }
@@ -71,7 +70,6 @@ impl Job {
         self.obstacles.clear();
         self.obstacles.extend_from_slice(d.obstacles);
         self.distance_cost_off = d.distance_cost_off;
-        self.own_ship = d.own_ship;
         match (&mut self.waterway, d.waterway) {
             (Some((lane, margin)), Some(w)) => {
                 lane.clone_from(w.lane);
@@ -90,7 +88,6 @@ impl Job {
             rho: self.rho,
             obstacles: &self.obstacles,
             distance_cost_off: self.distance_cost_off,
-            own_ship: self.own_ship,
             waterway: self.waterway.as_ref().map(|(lane, margin)| Waterway {
                 lane,
                 margin: *margin,
