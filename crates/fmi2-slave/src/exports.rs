@@ -567,24 +567,20 @@ pub unsafe fn free_instance<M: Fmi2Model>(c: Fmi2Component) {
         let Instance {
             mut model, logger, ..
         } = *boxed;
-        if let Err(payload) = catch_unwind(AssertUnwindSafe(|| model.release(&logger))) {
-            let text = panic_text(payload.as_ref());
-            drop_payload(payload);
-            logger.log(
-                Fmi2Status::Fatal,
-                status_category(Fmi2Status::Fatal),
-                &format!("fmi2FreeInstance: panic while releasing the model: {text}"),
-            );
-        }
-        if let Err(payload) = catch_unwind(AssertUnwindSafe(move || drop(model))) {
-            let text = panic_text(payload.as_ref());
-            drop_payload(payload);
-            logger.log(
-                Fmi2Status::Fatal,
-                status_category(Fmi2Status::Fatal),
-                &format!("fmi2FreeInstance: panic while dropping the model: {text}"),
-            );
-        }
+        let guarded = |what: &str, f: &mut dyn FnMut()| {
+            if let Err(payload) = catch_unwind(AssertUnwindSafe(f)) {
+                let text = panic_text(payload.as_ref());
+                drop_payload(payload);
+                logger.log(
+                    Fmi2Status::Fatal,
+                    status_category(Fmi2Status::Fatal),
+                    &format!("fmi2FreeInstance: panic while {what} the model: {text}"),
+                );
+            }
+        };
+        guarded("releasing", &mut || model.release(&logger));
+        let mut model = Some(model);
+        guarded("dropping", &mut || drop(model.take()));
     }
     // Everything of the instance is dropped: it no longer holds the library's tables.
     unload::instance_ended();

@@ -408,11 +408,8 @@ impl ControllerConfig {
     /// inside the bank it stalls between hazard a and the bank, `docs/RESULTS.md`).
     #[must_use]
     pub fn waterway(&self) -> Option<(Lane, [f64; 3])> {
-        if !self.tuning.scheme.alters() {
-            return None;
-        }
+        let half_width = self.mpc_waterway_half_width()?;
         let s = &self.scenario;
-        let half_width = self.guidance().waterway_half_width?;
         let margin = |d: &towing_model::VesselData| HullRect::of(d).radius() + 0.1;
         Some((
             Lane::new(Polyline::of_route(&s.route), half_width),
@@ -422,6 +419,16 @@ impl ControllerConfig {
                 margin(&s.tug_data[1]),
             ],
         ))
+    }
+
+    /// The half width of the waterway the MPC keeps to ([`ControllerConfig::waterway`]),
+    /// without building its lane.
+    #[must_use]
+    pub fn mpc_waterway_half_width(&self) -> Option<f64> {
+        if !self.tuning.scheme.alters() {
+            return None;
+        }
+        self.guidance().waterway_half_width
     }
 
     /// The reference system's settings: the tuning's, with the waterway and the

@@ -1149,7 +1149,7 @@ pub fn mpc_params(
     config: &ControllerConfig,
 ) -> (towing_mpc::ShipMpcParams, towing_mpc::TugMpcParams) {
     let (mut ship, mut tug) = (config.tuning.ship, config.tuning.tug);
-    ship.waterway_rows = config.waterway().is_some();
+    ship.waterway_rows = config.mpc_waterway_half_width().is_some();
     tug.waterway_rows = ship.waterway_rows;
     if !config.tuning.scheme.distance_cost() {
         ship.weight_distance = 0.0;

@@ -8,9 +8,9 @@
 //! for the MPC and the heading floor) and hands it to the distributed or the
 //! centralized solver. [`Controller::last_mpc_input`](crate::Controller::last_mpc_input)
 //! returns a copy of it, so that exactly the same problem can be solved again by
-//! another solver or by a fresh instance of the same one. The waterway's bank rows are
-//! not part of the copy (`as_sample_input` gives open water): the baseline's scenario,
-//! the paper's, has no waterway section.
+//! another solver or by a fresh instance of the same one. The waterway is not part of the
+//! copy (`as_sample_input` gives open water): the side-by-side baseline compares the two
+//! solvers on the problem without bank rows (`docs/controller-design.md`, "The waterway").
 
 use towing_model::MAX_OBSTACLES;
 use towing_mpc::{AppliedCommand, Obstacle, SampleInput, ShipState, TugState, HORIZON};

@@ -74,7 +74,7 @@ use towing_model::{HullModel, ParamError, Scenario};
 
 use crate::admm::{AdmmBuildError, SampleInput};
 use crate::costs::{
-    angle_difference, bank_terms, obstacle_terms, ship_stage_terms, thrust_rate_terms,
+    angle_difference, bank_terms, obstacle_terms, ship_stage_terms, thrust_rate_terms, At,
 };
 use crate::engine::{
     Block, BlockMut, Budget, InputSpace, Merit, PairRows, QuadModel, RowSet, Scp, ScpReport,
@@ -447,6 +447,12 @@ impl CentralProblem {
             input.heading_floor,
         );
         sp.motion.terms(quad, motion, h, x, rows);
+        let at = At {
+            h,
+            pos: [x[0], x[1]],
+            row_x: &rows[0],
+            row_y: &rows[1],
+        };
         obstacle_terms(
             quad,
             input.obstacles,
@@ -455,15 +461,10 @@ impl CentralProblem {
             sp.weight_distance,
             &sp.clearance,
             clearance,
-            h,
-            [x[0], x[1]],
-            &rows[0],
-            &rows[1],
+            at,
         );
         if let Some(waterway) = &input.waterway {
-            let params = sp.clearance.bank(sp.waterway_rows);
-            let p = [x[0], x[1]];
-            bank_terms(quad, waterway, 0, &params, bank, h, p, &rows[0], &rows[1]);
+            bank_terms(quad, (waterway, 0), sp.clearance.penalty, bank, at);
         }
     }
 
@@ -538,6 +539,12 @@ impl CentralProblem {
                         |h, c| tug_var(i, h, c),
                     );
                 }
+                let at = At {
+                    h,
+                    pos: [g[0], g[1]],
+                    row_x: &rows[0],
+                    row_y: &rows[1],
+                };
                 obstacle_terms(
                     quad,
                     input.obstacles,
@@ -546,25 +553,11 @@ impl CentralProblem {
                     tp.weight_distance,
                     &tp.clearance,
                     rows_out.as_deref_mut().map(|r| &mut r.clearance[1 + i]),
-                    h,
-                    [g[0], g[1]],
-                    &rows[0],
-                    &rows[1],
+                    at,
                 );
                 if let Some(waterway) = &input.waterway {
                     let bank = rows_out.as_deref_mut().map(|r| &mut r.bank[1 + i]);
-                    let (p, params) = ([g[0], g[1]], tp.clearance.bank(tp.waterway_rows));
-                    bank_terms(
-                        quad,
-                        waterway,
-                        1 + i,
-                        &params,
-                        bank,
-                        h,
-                        p,
-                        &rows[0],
-                        &rows[1],
-                    );
+                    bank_terms(quad, (waterway, 1 + i), tp.clearance.penalty, bank, at);
                 }
                 out.tugs[i] += quad.value - start;
             }

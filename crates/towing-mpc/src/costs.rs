@@ -114,34 +114,46 @@ pub struct Waterway<'a> {
     pub margin: [f64; 3],
 }
 
-/// The bank row of vessel `vessel` (0 ship, 1 tug 1, 2 tug 2) at its predicted position
-/// `pos` after sample `h`: `b(p) = half_width - d(p) >= margin - s`, `d` the distance from
-/// the route ([`Lane::distance_and_gradient`]), linearised like the clearance rows
+/// A vessel's predicted position `pos` after sample `h`, with `d(x, y)/du = (row_x, row_y)`
+/// over the QP's increments: where the obstacle and bank terms are evaluated.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct At<'r, const N: usize> {
+    pub h: usize,
+    pub pos: [f64; 2],
+    pub row_x: &'r [f64; N],
+    pub row_y: &'r [f64; N],
+}
+
+impl<const N: usize> At<'_, N> {
+    /// `d f/du` of a function `f` of the position with gradient `grad` there.
+    fn row(&self, grad: [f64; 2]) -> [f64; N] {
+        let mut row = [0.0; N];
+        for (r, (a, b)) in row.iter_mut().zip(self.row_x.iter().zip(self.row_y)) {
+            *r = grad[0] * a + grad[1] * b;
+        }
+        row
+    }
+}
+
+/// The bank row of vessel `vessel` (0 ship, 1 tug 1, 2 tug 2) at `at`:
+/// `b(p) = half_width - d(p) >= margin - s`, `d` the distance from the route
+/// ([`Lane::distance_and_gradient`]), linearised like the clearance rows
 /// (`b + grad b . (row_x, row_y) du >= margin - s`, `grad b = -grad d`), with the exact L1
-/// penalty of `params` on the slack (Nocedal and Wright 2006, section 17.2) in the true
-/// cost too.
-#[allow(clippy::too_many_arguments)] // the pieces of one row; as obstacle_terms
+/// penalty `penalty` (per m) on the slack (Nocedal and Wright 2006, section 17.2) in the
+/// true cost too.
 pub(crate) fn bank_terms<const N: usize>(
     quad: &mut QuadModel,
-    waterway: &Waterway<'_>,
-    vessel: usize,
-    params: &ClearanceParams,
+    (waterway, vessel): (&Waterway<'_>, usize),
+    penalty: f64,
     rows: Option<&mut SlotRows>,
-    h: usize,
-    pos: [f64; 2],
-    row_x: &[f64; N],
-    row_y: &[f64; N],
+    at: At<'_, N>,
 ) {
-    let (d, grad) = waterway.lane.distance_and_gradient(pos);
+    let (d, grad) = waterway.lane.distance_and_gradient(at.pos);
     let clearance = waterway.lane.half_width - d;
     let margin = waterway.margin[vessel];
-    quad.value += params.penalty * (margin - clearance).max(0.0);
+    quad.value += penalty * (margin - clearance).max(0.0);
     if let Some(r) = rows {
-        let mut row = [0.0; N];
-        for (v, (a, b)) in row.iter_mut().zip(row_x.iter().zip(row_y)) {
-            *v = -(grad[0] * a + grad[1] * b);
-        }
-        r.record(h, 0, clearance, margin, &row);
+        r.record(at.h, 0, clearance, margin, &at.row([-grad[0], -grad[1]]));
     }
 }
 
@@ -249,12 +261,11 @@ impl MotionLimits {
     }
 }
 
-/// The obstacle terms of one predicted position `pos` (the state after sample
-/// `h`; moving obstacles as predicted then, [`Obstacle::after`]) with
-/// `d(x, y)/du = (row_x, row_y)`: the distance cost `w phi(d)` of every obstacle
-/// but those of `distance_cost_off` (bit `j` for `obstacles[j]`) and, for the first
-/// `params.max_obstacles`, the clearance penalty and (with `clearance`) the
-/// linearised row.
+/// The obstacle terms of one predicted position `at` (the state after sample
+/// `at.h`; moving obstacles as predicted then, [`Obstacle::after`]): the distance
+/// cost `w phi(d)` of every obstacle but those of `distance_cost_off` (bit `j` for
+/// `obstacles[j]`) and, for the first `params.max_obstacles`, the clearance penalty
+/// and (with `clearance`) the linearised row.
 #[allow(clippy::too_many_arguments)] // the pieces of one term; three call sites
 pub(crate) fn obstacle_terms<const N: usize>(
     quad: &mut QuadModel,
@@ -264,17 +275,12 @@ pub(crate) fn obstacle_terms<const N: usize>(
     w: f64,
     params: &ClearanceParams,
     mut clearance: Option<&mut SlotRows>,
-    h: usize,
-    pos: [f64; 2],
-    row_x: &[f64; N],
-    row_y: &[f64; N],
+    at: At<'_, N>,
 ) {
+    let h = at.h;
     for (j, obstacle) in obstacles.iter().enumerate() {
-        let (d, grad) = obstacle.after(h + 1).distance(pos);
-        let mut row = [0.0; N];
-        for (r, (a, b)) in row.iter_mut().zip(row_x.iter().zip(row_y)) {
-            *r = grad[0] * a + grad[1] * b;
-        }
+        let (d, grad) = obstacle.after(h + 1).distance(at.pos);
+        let row = at.row(grad);
         if j >= 64 || (distance_cost_off >> j) & 1 == 0 {
             let (phi, slope, curvature) = distance.eval(d);
             quad.curved(phi, slope, curvature, w, &row);

@@ -31,8 +31,8 @@
 use nalgebra::Matrix6x4;
 
 use crate::costs::{
-    angle_difference, bank_terms, obstacle_terms, ship_stage_terms, ClearanceParams, MotionLimits,
-    Waterway,
+    angle_difference, bank_terms, obstacle_terms, ship_stage_terms, At, ClearanceParams,
+    MotionLimits, Waterway,
 };
 use crate::engine::{
     Block, BlockMut, Channel, InputSpace, QuadModel, RowSet, Scp, ScpSettings, SlotRows,
@@ -511,6 +511,12 @@ fn accumulate(
                 quad.residual(res[c], 0.5 * data.rho, data.lambda[i][h][c], &row);
             }
         }
+        let at = At {
+            h,
+            pos: [x[0], x[1]],
+            row_x: &rows[0],
+            row_y: &rows[1],
+        };
         obstacle_terms(
             quad,
             data.obstacles,
@@ -519,23 +525,11 @@ fn accumulate(
             w3,
             &params.clearance,
             soft.as_deref_mut().map(|r| &mut r.clearance),
-            h,
-            [x[0], x[1]],
-            &rows[0],
-            &rows[1],
+            at,
         );
         if let Some(waterway) = &data.waterway {
-            bank_terms(
-                quad,
-                waterway,
-                0,
-                &params.clearance,
-                soft.as_deref_mut().map(|r| &mut r.bank),
-                h,
-                [x[0], x[1]],
-                &rows[0],
-                &rows[1],
-            );
+            let bank = soft.as_deref_mut().map(|r| &mut r.bank);
+            bank_terms(quad, (waterway, 0), params.clearance.penalty, bank, at);
         }
     }
 }

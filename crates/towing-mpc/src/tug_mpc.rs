@@ -27,7 +27,7 @@
 
 use nalgebra::Matrix6x3;
 
-use crate::costs::{angle_difference, bank_terms, obstacle_terms, ClearanceParams, Waterway};
+use crate::costs::{angle_difference, bank_terms, obstacle_terms, At, ClearanceParams, Waterway};
 use crate::engine::{
     Block, BlockMut, Channel, InputSpace, QuadModel, RowSet, Scp, ScpSettings, SlotRows,
     Subproblem, ALL_VESSELS,
@@ -324,7 +324,6 @@ fn accumulate(
     mut slots: Option<&mut TugRows>,
     data: &TugStepData<'_>,
 ) {
-    let bank = params.clearance.bank(params.waterway_rows);
     let (wp, wv) = params.state_weights();
     let w3 = params.weight_distance;
     let mut rows = [[0.0; N]; 6];
@@ -345,6 +344,12 @@ fn accumulate(
             quad.residual(err[c], wp[c] + 0.5 * data.rho, data.lambda[h][c], &rows[c]);
             quad.residual(x[3 + c], wv[c], 0.0, &rows[3 + c]);
         }
+        let at = At {
+            h,
+            pos: [x[0], x[1]],
+            row_x: &rows[0],
+            row_y: &rows[1],
+        };
         obstacle_terms(
             quad,
             data.obstacles,
@@ -353,23 +358,11 @@ fn accumulate(
             w3,
             &params.clearance,
             slots.as_deref_mut().map(|r| &mut r.clearance),
-            h,
-            [x[0], x[1]],
-            &rows[0],
-            &rows[1],
+            at,
         );
         if let Some(waterway) = &data.waterway {
-            bank_terms(
-                quad,
-                waterway,
-                vessel,
-                &bank,
-                slots.as_deref_mut().map(|r| &mut r.bank),
-                h,
-                [x[0], x[1]],
-                &rows[0],
-                &rows[1],
-            );
+            let bank = slots.as_deref_mut().map(|r| &mut r.bank);
+            bank_terms(quad, (waterway, vessel), params.clearance.penalty, bank, at);
         }
     }
 }

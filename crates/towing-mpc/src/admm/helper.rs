@@ -70,9 +70,13 @@ impl Job {
         self.obstacles.clear();
         self.obstacles.extend_from_slice(d.obstacles);
         self.distance_cost_off = d.distance_cost_off;
+        // The lane is the run's, the same every step: copied only when it differs, so the
+        // per-iteration hand-over allocates nothing.
         match (&mut self.waterway, d.waterway) {
             (Some((lane, margin)), Some(w)) => {
-                lane.clone_from(w.lane);
+                if lane != w.lane {
+                    lane.clone_from(w.lane);
+                }
                 *margin = w.margin;
             }
             (kept, w) => *kept = w.map(|w| (w.lane.clone(), w.margin)),
