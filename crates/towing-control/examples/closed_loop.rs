@@ -2,6 +2,7 @@
 //! communication step 0.1 s. A development tool and a reference for the FMU runs.
 //!
 //! `cargo run --release -p towing-control --example closed_loop -- [stop_s] [scheme] [csv]`
+//! (`SCENARIO=file.toml` runs that scenario instead of the paper's)
 // A command-line tool: printing is its output.
 #![allow(clippy::print_stdout, clippy::print_stderr)]
 
@@ -116,7 +117,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let stop: f64 = args.get(1).map_or(Ok(1200.0), |s| s.parse())?;
     let scheme = AvoidanceScheme::from_code(args.get(2).map_or(Ok(1), |s| s.parse())?)?;
-    let mut scenario = Scenario::paper()?;
+    let mut scenario = match std::env::var("SCENARIO") {
+        Ok(path) => Scenario::from_file(path)?,
+        Err(_) => Scenario::paper()?,
+    };
     if std::env::var("NO_OBST").is_ok() {
         scenario.obstacles.clear();
     }
@@ -199,6 +203,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(v) = env("TUG_TR_N") {
         config.tuning.tug.trust_scale[2] = v;
     }
+    if let Some(v) = env("TUG_RMAX") {
+        config.tuning.tug.max_yaw_rate = v;
+    }
+    if let Some(v) = env("OWN_SHIP") {
+        config.tuning.tug.own_ship_row = v > 0.0;
+    }
     if let Some(v) = env("PT_W") {
         config.tuning.ship.weight_port_turn = v;
     }
@@ -236,6 +246,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // Per obstacle slot: (CPA distance, time, relative bearing in deg) of target ships.
     let mut cpa: [(f64, f64, f64); towing_model::MAX_OBSTACLES] =
         [(f64::INFINITY, 0.0, 0.0); towing_model::MAX_OBSTACLES];
+    let mut max_tug_r = 0.0f64;
     let wall = std::time::Instant::now();
     for n in 0..steps {
         let m = Measurement::from_world(&world);
@@ -286,9 +297,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
             h,
         )?;
-        for o in world.obstacles() {
-            let _ = o;
-        }
+        max_tug_r = max_tug_r.max(world.tug(0).nu[2].abs().max(world.tug(1).nu[2].abs()));
         if let Some(f) = csv.as_mut() {
             let s = world.ship();
             let (t1, t2) = (world.tug(0), world.tug(1));
@@ -382,11 +391,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     iters.sort_unstable();
     let s = world.ship();
     println!(
-        "end t={:.0}: ship at ({:.2}, {:.2}) psi {:.1} deg, u {:.3}; wall {:.2} s; sample ms median {:.2} p99 {:.2} max {:.2}; iterations median {} p99 {} max {}; not converged {}; fallbacks {}; min crude clearance {:.2} m; settled at {:?}; overlaps {}",
+        "end t={:.0}: ship at ({:.2}, {:.2}) psi {:.1} deg, u {:.3}; wall {:.2} s; sample ms median {:.2} p99 {:.2} max {:.2}; iterations median {} p99 {} max {}; not converged {}; fallbacks {}; min crude clearance {:.2} m; settled at {:?}; overlaps {}; max tug yaw rate {:.2} rad/s",
         world.time(), s.eta[0], s.eta[1], s.eta[2].to_degrees(), s.nu[0], wall.elapsed().as_secs_f64(),
         times[times.len() / 2], times[times.len() * 99 / 100], times[times.len() - 1],
         iters[iters.len() / 2], iters[iters.len() * 99 / 100], iters[iters.len() - 1], not_converged,
-        controller.fallbacks(), min_clear, settled_since, collisions
+        controller.fallbacks(), min_clear, settled_since, collisions, max_tug_r
     );
     Ok(())
 }

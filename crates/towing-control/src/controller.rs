@@ -1143,7 +1143,8 @@ fn mpc_obstacle(o: &ObstacleSlot, sample_time: f64) -> Obstacle {
 
 /// The ship's and the tugs' MPC parameters a [`Controller`] of `config` uses: the
 /// tuning's, with the distance weights zeroed when the scheme has no distance cost
-/// (scheme II).
+/// (scheme II), and without the bank, tug yaw-rate and own-ship rows in scheme III (the paper's
+/// baseline keeps its printed formulation).
 #[must_use]
 pub fn mpc_params(
     config: &ControllerConfig,
@@ -1151,6 +1152,11 @@ pub fn mpc_params(
     let (mut ship, mut tug) = (config.tuning.ship, config.tuning.tug);
     ship.waterway_rows = config.mpc_waterway_half_width().is_some();
     tug.waterway_rows = ship.waterway_rows;
+    if !config.tuning.scheme.alters() {
+        // Scheme III, the paper's distance-cost-only baseline, keeps eq. (16) as printed.
+        tug.max_yaw_rate = f64::INFINITY;
+        tug.own_ship_row = false;
+    }
     if !config.tuning.scheme.distance_cost() {
         ship.weight_distance = 0.0;
         tug.weight_distance = 0.0;

@@ -442,6 +442,18 @@ pub static PARAMETERS: &[Parameter] = &[
         },
     },
     Parameter {
+        name: "mpc.tug.max_yaw_rate",
+        old_name: None,
+        description: "Soft limit of each tug's predicted yaw rate |r| (schemes I and II; not in the paper): the TitoNeri's yaw is nearly undamped and 10 N.m held over a sample spins it up by 4.3 rad/s; without the limit tugs spun up to 30 rad/s in the encounter suites; 0.5 rad/s (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "rad/s",
+            min: Limit::Above(0.0),
+            max: Limit::None,
+            get: |t| t.tug.max_yaw_rate,
+            set: |t, v| t.tug.max_yaw_rate = v,
+        },
+    },
+    Parameter {
         name: "admm.rho",
         old_name: Some("rho"),
         description: "ADMM penalty rho of eq. (22), per m^2 of position and per rad^2 of heading residual; not given by the paper, 20 chosen by measurement (towing-mpc rho_sweep, docs/assumptions.md)",

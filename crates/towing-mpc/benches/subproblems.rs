@@ -40,6 +40,7 @@ fn bench(c: &mut Criterion) {
         obstacles: &obstacles,
         distance_cost_off: 0,
         waterway: None,
+        own_ship: None,
     };
     let tug_plan = [[1.0, 0.0, 0.0]; HORIZON];
     c.bench_function("tug_scp_step", |b| {

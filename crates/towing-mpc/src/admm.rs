@@ -614,6 +614,7 @@ impl Core<'_> {
         tug_states: &[TugState; 2],
         side: &ShipSide,
     ) -> ([ScpReport; 2], [Poses; 2]) {
+        let own_ship = self.formation.ship_obstacle(&input.ship, &side.states);
         let data = |i: usize| TugStepData {
             state: tug_states[i],
             pulls: std::array::from_fn(|h| {
@@ -630,6 +631,7 @@ impl Core<'_> {
             obstacles: input.obstacles,
             distance_cost_off: input.distance_cost_off,
             waterway: input.waterway,
+            own_ship: Some(own_ship),
         };
         self.tug2.start(&data(1));
         let first = self.tug1.step(&data(0));

@@ -74,7 +74,8 @@ use towing_model::{HullModel, ParamError, Scenario};
 
 use crate::admm::{AdmmBuildError, SampleInput};
 use crate::costs::{
-    angle_difference, bank_terms, obstacle_terms, ship_stage_terms, thrust_rate_terms, At,
+    angle_difference, bank_terms, obstacle_terms, ship_stage_terms, thrust_rate_terms,
+    tug_yaw_rate_terms, At,
 };
 use crate::engine::{
     Block, BlockMut, Budget, InputSpace, Merit, PairRows, QuadModel, RowSet, Scp, ScpReport,
@@ -322,6 +323,7 @@ pub struct CentralRows {
     clearance: [SlotRows; 3],
     motion: SlotRows,
     bank: [SlotRows; 3],
+    yaw: [SlotRows; 2],
 }
 
 impl RowSet for CentralRows {
@@ -330,12 +332,14 @@ impl RowSet for CentralRows {
             .chain(self.clearance.iter().map(Block::Slots))
             .chain(std::iter::once(Block::Slots(&self.motion)))
             .chain(self.bank.iter().map(Block::Slots))
+            .chain(self.yaw.iter().map(Block::Slots))
     }
     fn blocks_mut(&mut self) -> impl Iterator<Item = BlockMut<'_>> {
         std::iter::once(BlockMut::Pairs(&mut self.consensus))
             .chain(self.clearance.iter_mut().map(BlockMut::Slots))
             .chain(std::iter::once(BlockMut::Slots(&mut self.motion)))
             .chain(self.bank.iter_mut().map(BlockMut::Slots))
+            .chain(self.yaw.iter_mut().map(BlockMut::Slots))
     }
 }
 
@@ -559,6 +563,8 @@ impl CentralProblem {
                     let bank = rows_out.as_deref_mut().map(|r| &mut r.bank[1 + i]);
                     bank_terms(quad, (waterway, 1 + i), tp.clearance.penalty, bank, at);
                 }
+                let yaw = rows_out.as_deref_mut().map(|r| &mut r.yaw[i]);
+                tug_yaw_rate_terms(quad, tp.yaw_rate_limit(), yaw, h, g[5], &rows[5]);
                 out.tugs[i] += quad.value - start;
             }
         }
@@ -656,6 +662,10 @@ impl Subproblem for CentralProblem {
                     .clearance
                     .bank(self.tug_params.waterway_rows))
                 .rows(PER_STEP, TUG[1]),
+            ],
+            yaw: [
+                self.tug_params.yaw_rate_rows(PER_STEP, TUG[0]),
+                self.tug_params.yaw_rate_rows(PER_STEP, TUG[1]),
             ],
         }
     }

@@ -157,6 +157,43 @@ pub(crate) fn bank_terms<const N: usize>(
     }
 }
 
+/// A tug's yaw-rate limit `|r| <= max_rate` as two soft rows per sample (exact L1
+/// penalty `penalty` per rad/s on the slack, [`SlotRows`]; Nocedal and Wright 2006,
+/// section 17.2): the rows of [`tug_yaw_rate_rows`], filled by [`tug_yaw_rate_terms`].
+/// The TitoNeri's yaw is nearly undamped (`d33` = 0.105 N m s, `I_z + N_rdot` = 2.31
+/// kg m^2, `reference/vessels.md`): the 10 N m of eq. (19) held over one 1 s sample
+/// spin it up by 4.3 rad/s, and a plan free to do so ran tugs up to 30 rad/s in the
+/// closed loop (`docs/controller-design.md`, "Tug local MPCs"). An infinite limit
+/// builds no rows.
+#[must_use]
+pub fn tug_yaw_rate_rows(max_rate: f64, penalty: f64, per_step: usize, vessels: u8) -> SlotRows {
+    let slots = if max_rate.is_finite() { 2 } else { 0 };
+    SlotRows::new(slots, (HORIZON, per_step), vessels, penalty, 100.0)
+}
+
+/// The penalty of the predicted yaw rate `r` after sample `h` against `max_rate`
+/// and, with `rows`, its two linearised rows (`dr` = `d r / du`).
+pub(crate) fn tug_yaw_rate_terms<const N: usize>(
+    quad: &mut QuadModel,
+    (max_rate, penalty): (f64, f64),
+    mut rows: Option<&mut SlotRows>,
+    h: usize,
+    r: f64,
+    dr: &[f64; N],
+) {
+    if !max_rate.is_finite() {
+        return;
+    }
+    for (j, sign) in [1.0, -1.0].into_iter().enumerate() {
+        let value = sign * r;
+        quad.value += penalty * (-max_rate - value).max(0.0);
+        if let Some(slots) = rows.as_deref_mut() {
+            let row: [f64; N] = std::array::from_fn(|k| sign * dr[k]);
+            slots.record(h, j, value, -max_rate, &row);
+        }
+    }
+}
+
 /// Soft limits on the ship's predicted motion, the seamanship of
 /// `docs/colregs.md` ("Seamanship") made constraints of the MPC: no drift angle
 /// above `max_drift` under way, no sternway beyond `max_sternway`, no surge above

@@ -14,7 +14,9 @@ use nalgebra::Matrix3x4;
 use towing_model::towline::formation_pose;
 use towing_model::{ParamError, Scenario, VesselData};
 
+use crate::obstacle::Obstacle;
 use crate::ship::{ShipInput, ShipState};
+use crate::HORIZON;
 
 /// Desired tug poses from the ship's pose and towing angles (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,6 +27,25 @@ pub struct FormationMap {
 }
 
 impl FormationMap {
+    /// The ship's hull as the tugs' local problems keep clear of it (`docs/controller-design.md`,
+    /// "Tug local MPCs"): the ellipse through the corners of the ship's `L x B` rectangle
+    /// (semi-axes `L / sqrt 2`, `B / sqrt 2`, the smallest ellipse of the hull's aspect
+    /// that contains it) at the ship's present pose `ship`, heading held, moving by the
+    /// mean displacement per sample of the coordination's predicted trajectory
+    /// `predicted` (the constant-velocity motion [`Obstacle::after`] predicts).
+    #[must_use]
+    pub fn ship_obstacle(&self, ship: &ShipState, predicted: &[ShipState; HORIZON]) -> Obstacle {
+        let last = predicted[HORIZON - 1];
+        let k = HORIZON as f64;
+        Obstacle::Ellipse {
+            centre: [ship[0], ship[1]],
+            semi_major: self.ship.length * std::f64::consts::FRAC_1_SQRT_2,
+            semi_minor: self.ship.width.min(self.ship.length) * std::f64::consts::FRAC_1_SQRT_2,
+            orientation: ship[2],
+            drift: [(last[0] - ship[0]) / k, (last[1] - ship[1]) / k],
+        }
+    }
+
     /// The map for a ship, the two tugs (0 = tug 1 aft, 1 = tug 2 forward) and the
     /// desired line lengths `l_tow1`, `l_tow2` (m, attachment point to attachment
     /// point, finite and > 0). The vessel data are validated.

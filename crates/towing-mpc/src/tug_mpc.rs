@@ -27,7 +27,10 @@
 
 use nalgebra::Matrix6x3;
 
-use crate::costs::{angle_difference, bank_terms, obstacle_terms, At, ClearanceParams, Waterway};
+use crate::costs::{
+    angle_difference, bank_terms, obstacle_terms, tug_yaw_rate_rows, tug_yaw_rate_terms, At,
+    ClearanceParams, Waterway,
+};
 use crate::engine::{
     Block, BlockMut, Channel, InputSpace, QuadModel, RowSet, Scp, ScpSettings, SlotRows,
     Subproblem, ALL_VESSELS,
@@ -67,6 +70,14 @@ pub struct TugMpcParams {
     pub clearance: ClearanceParams,
     /// Bank rows built into the problem ([`crate::ShipMpcParams::waterway_rows`]).
     pub waterway_rows: bool,
+    /// A clearance row about the tow's own ship ([`TugStepData::own_ship`]) built into
+    /// the problem (the default; not in the paper); `false` (eq. (16) as printed) builds
+    /// none.
+    pub own_ship_row: bool,
+    /// Largest predicted yaw rate `|r|` (rad/s): two soft rows per sample with the
+    /// clearance rows' L1 penalty (per rad/s), [`tug_yaw_rate_terms`]; default 0.5 rad/s
+    /// (`docs/assumptions.md`); infinite (eq. (16) as printed): no rows. Not in the paper.
+    pub max_yaw_rate: f64,
 }
 
 impl Default for TugMpcParams {
@@ -84,6 +95,8 @@ impl Default for TugMpcParams {
             distance: DistanceCost::default(),
             clearance: ClearanceParams::with_min_distance(0.6),
             waterway_rows: false,
+            own_ship_row: true,
+            max_yaw_rate: 0.5,
         }
     }
 }
@@ -100,6 +113,19 @@ impl TugMpcParams {
             ],
             [self.weight_surge, self.weight_sway, self.weight_yaw_rate],
         )
+    }
+
+    /// The yaw-rate limit and its penalty ([`tug_yaw_rate_terms`]).
+    #[must_use]
+    pub fn yaw_rate_limit(&self) -> (f64, f64) {
+        (self.max_yaw_rate, self.clearance.penalty)
+    }
+
+    /// The yaw-rate rows over `per_step` increments per sample, about `vessels`.
+    #[must_use]
+    pub fn yaw_rate_rows(&self, per_step: usize, vessels: u8) -> SlotRows {
+        let (max_rate, penalty) = self.yaw_rate_limit();
+        tug_yaw_rate_rows(max_rate, penalty, per_step, vessels)
     }
 
     /// The three input channels of a sample (`X, Y, N`): bounded, no rate bound.
@@ -135,6 +161,13 @@ pub struct TugStepData<'a> {
     pub distance_cost_off: u64,
     /// The waterway ([`crate::SampleInput::waterway`]).
     pub waterway: Option<Waterway<'a>>,
+    /// The tow's own ship as the coordination predicts it
+    /// ([`crate::FormationMap::ship_obstacle`]), kept at the clearance distance by a row
+    /// of its own (with [`TugMpcParams::own_ship_row`]) and no distance cost: the tug
+    /// works next to it, its line keeps it at the formation's distance, and only a tug
+    /// driven onto the hull (dodging a target, or overrun) must be stopped. `None`: no
+    /// such row (a tug alone).
+    pub own_ship: Option<Obstacle>,
 }
 
 /// A tug's local problem (module docs).
@@ -158,17 +191,27 @@ pub struct TugLinearised {
 #[derive(Debug, Clone)]
 pub struct TugRows {
     clearance: SlotRows,
+    own_ship: SlotRows,
     bank: SlotRows,
+    yaw: SlotRows,
 }
 
 impl RowSet for TugRows {
     fn blocks(&self) -> impl Iterator<Item = Block<'_>> {
-        [Block::Slots(&self.clearance), Block::Slots(&self.bank)].into_iter()
+        [
+            Block::Slots(&self.clearance),
+            Block::Slots(&self.own_ship),
+            Block::Slots(&self.bank),
+            Block::Slots(&self.yaw),
+        ]
+        .into_iter()
     }
     fn blocks_mut(&mut self) -> impl Iterator<Item = BlockMut<'_>> {
         [
             BlockMut::Slots(&mut self.clearance),
+            BlockMut::Slots(&mut self.own_ship),
             BlockMut::Slots(&mut self.bank),
+            BlockMut::Slots(&mut self.yaw),
         ]
         .into_iter()
     }
@@ -219,9 +262,13 @@ impl Subproblem for TugProblem {
     fn rows(&self) -> TugRows {
         TugRows {
             clearance: self.params.clearance.rows(3, ALL_VESSELS),
+            own_ship: (self.params.clearance)
+                .bank(self.params.own_ship_row)
+                .rows(3, ALL_VESSELS),
             bank: (self.params.clearance)
                 .bank(self.params.waterway_rows)
                 .rows(3, ALL_VESSELS),
+            yaw: self.params.yaw_rate_rows(3, ALL_VESSELS),
         }
     }
 
@@ -360,10 +407,24 @@ fn accumulate(
             slots.as_deref_mut().map(|r| &mut r.clearance),
             at,
         );
+        if let (true, Some(ship)) = (params.own_ship_row, &data.own_ship) {
+            obstacle_terms(
+                quad,
+                std::slice::from_ref(ship),
+                1,
+                &params.distance,
+                0.0,
+                &params.clearance,
+                slots.as_deref_mut().map(|r| &mut r.own_ship),
+                at,
+            );
+        }
         if let Some(waterway) = &data.waterway {
             let bank = slots.as_deref_mut().map(|r| &mut r.bank);
             bank_terms(quad, (waterway, vessel), params.clearance.penalty, bank, at);
         }
+        let yaw = slots.as_deref_mut().map(|r| &mut r.yaw);
+        tug_yaw_rate_terms(quad, params.yaw_rate_limit(), yaw, h, x[5], &rows[5]);
     }
 }
 
@@ -375,15 +436,7 @@ mod tests {
     use crate::PredictionParams;
 
     fn tug_mpc() -> TugMpc {
-        let scenario = Scenario::paper().unwrap();
-        let model = TugModel::from_scenario(
-            &scenario,
-            1,
-            HullModel::NonlinearDamping,
-            PredictionParams::default(),
-        )
-        .unwrap();
-        TugMpc::new(model, TugMpcParams::default()).unwrap()
+        tug_mpc_with(TugMpcParams::default())
     }
 
     fn data_ahead(obstacles: &[Obstacle]) -> TugStepData<'_> {
@@ -397,6 +450,7 @@ mod tests {
             obstacles,
             distance_cost_off: 0,
             waterway: None,
+            own_ship: None,
         }
     }
 
@@ -495,15 +549,7 @@ mod tests {
                 },
                 ..defaults
             };
-            let scenario = Scenario::paper().unwrap();
-            let model = TugModel::from_scenario(
-                &scenario,
-                1,
-                HullModel::NonlinearDamping,
-                PredictionParams::default(),
-            )
-            .unwrap();
-            let mut mpc = TugMpc::new(model, params).unwrap();
+            let mut mpc = tug_mpc_with(params);
             let mut data = data_ahead(&obstacles);
             data.reference = [[1.5, 0.0, 0.0]; HORIZON];
             let mut last = f64::INFINITY;
@@ -524,5 +570,92 @@ mod tests {
         let kept = run(4);
         assert!(free < d_min - 0.05, "{free}");
         assert!(kept >= d_min - 1e-3, "{kept}");
+    }
+
+    fn tug_mpc_with(params: TugMpcParams) -> TugMpc {
+        let scenario = Scenario::paper().unwrap();
+        let model = TugModel::from_scenario(
+            &scenario,
+            1,
+            HullModel::NonlinearDamping,
+            PredictionParams::default(),
+        )
+        .unwrap();
+        TugMpc::new(model, params).unwrap()
+    }
+
+    /// A reference across the tow's own ship (a towing angle swung through the hull): the
+    /// own-ship row keeps the tug's plan at `d_min` from the hull ellipse, with no distance
+    /// cost of its own; without the ship in the data, or with the row off, the plan runs
+    /// onto the hull.
+    #[test]
+    fn the_own_ship_row_keeps_the_tug_off_the_hull() {
+        let scenario = Scenario::paper().unwrap();
+        let ship = crate::FormationMap::from_scenario(&scenario)
+            .unwrap()
+            .ship_obstacle(
+                &[1.4, 0.0, 1.5, 0.0, 0.0, 0.0],
+                &[[1.4, 0.0, 1.5, 0.0, 0.0, 0.0]; HORIZON],
+            );
+        let run = |own_ship: Option<Obstacle>, row: bool| {
+            let mut mpc = tug_mpc_with(TugMpcParams {
+                own_ship_row: row,
+                ..TugMpcParams::default()
+            });
+            let mut data = data_ahead(&[]);
+            data.reference = [[1.5, 0.0, 0.0]; HORIZON];
+            data.own_ship = own_ship;
+            for _ in 0..40 {
+                let report = mpc.step(&data);
+                assert!(report.qp.is_usable(), "{report:?}");
+                assert!(within_bounds(&mpc));
+            }
+            mpc.predicted()
+                .iter()
+                .map(|x| ship.distance([x[0], x[1]]).0)
+                .fold(f64::INFINITY, f64::min)
+        };
+        let d_min = TugMpcParams::default().clearance.min_distance;
+        let free = run(None, true);
+        let off = run(Some(ship), false);
+        let kept = run(Some(ship), true);
+        assert!(free < d_min - 0.05, "{free}");
+        assert!(off < d_min - 0.05, "{off}");
+        assert!(kept >= d_min - 1e-3, "{kept}");
+    }
+
+    /// A heading reference a half turn away: without the limit the plan spins the tug up
+    /// (the 10 N m moment against a yaw damping of 0.105 N m s); with it every predicted
+    /// yaw rate stays within `max_yaw_rate`, and the plan still turns the right way.
+    #[test]
+    fn the_yaw_rate_rows_keep_the_tug_from_spinning_up() {
+        let run = |max_yaw_rate: f64| {
+            let mut mpc = tug_mpc_with(TugMpcParams {
+                max_yaw_rate,
+                ..TugMpcParams::default()
+            });
+            let mut data = data_ahead(&[]);
+            data.reference = [[0.0, 0.0, 3.0]; HORIZON];
+            let mut fastest = 0.0f64;
+            let mut heading = 0.0;
+            for _ in 0..40 {
+                let report = mpc.step(&data);
+                assert!(report.qp.is_usable(), "{report:?}");
+                assert!(within_bounds(&mpc));
+                fastest = mpc
+                    .predicted()
+                    .iter()
+                    .map(|x| x[5].abs())
+                    .fold(fastest, f64::max);
+                heading = mpc.predicted()[HORIZON - 1][2];
+            }
+            (fastest, heading)
+        };
+        let limit = 0.5;
+        let (free, _) = run(f64::INFINITY);
+        let (held, heading) = run(limit);
+        assert!(free > 2.0 * limit, "{free}");
+        assert!(held <= limit + 1e-3, "{held}");
+        assert!(heading > 0.1, "{heading}");
     }
 }

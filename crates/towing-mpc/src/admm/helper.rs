@@ -56,6 +56,7 @@ struct Job {
     rho: f64,
     obstacles: Vec<Obstacle>,
     distance_cost_off: u64,
+    own_ship: Option<Obstacle>,
     /// The lane (cloned into the kept buffer) and the margins of the sample's waterway.
     waterway: Option<(Lane, [f64; 3])>,
 }
@@ -70,6 +71,7 @@ impl Job {
         self.obstacles.clear();
         self.obstacles.extend_from_slice(d.obstacles);
         self.distance_cost_off = d.distance_cost_off;
+        self.own_ship = d.own_ship;
         // The lane is the run's, the same every step: copied only when it differs, so the
         // per-iteration hand-over allocates nothing.
         match (&mut self.waterway, d.waterway) {
@@ -92,6 +94,7 @@ impl Job {
             rho: self.rho,
             obstacles: &self.obstacles,
             distance_cost_off: self.distance_cost_off,
+            own_ship: self.own_ship,
             waterway: self.waterway.as_ref().map(|(lane, margin)| Waterway {
                 lane,
                 margin: *margin,

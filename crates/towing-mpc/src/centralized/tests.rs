@@ -10,7 +10,7 @@ fn centralized(settings: CentralizedSettings) -> Centralized {
         HullModel::NonlinearDamping,
         PredictionParams::default(),
         crate::admm::tests::printed_cost(),
-        TugMpcParams::default(),
+        crate::admm::tests::printed_tug(),
         settings,
     )
     .unwrap()
@@ -71,7 +71,7 @@ fn tight_admm(rho: f64) -> Admm {
         HullModel::NonlinearDamping,
         PredictionParams::default(),
         crate::admm::tests::printed_cost(),
-        TugMpcParams::default(),
+        crate::admm::tests::printed_tug(),
         AdmmSettings {
             rho,
             max_iterations: MAX_ITERATIONS,
