@@ -160,11 +160,11 @@ pub(crate) fn bank_terms<const N: usize>(
 /// A tug's yaw-rate limit `|r| <= max_rate` as two soft rows per sample (exact L1
 /// penalty `penalty` per rad/s on the slack, [`SlotRows`]; Nocedal and Wright 2006,
 /// section 17.2): the rows of [`tug_yaw_rate_rows`], filled by [`tug_yaw_rate_terms`].
-/// The TitoNeri's yaw is nearly undamped (`d33` = 0.105 N m s, `I_z + N_rdot` = 2.31
+/// The TitoNeri's yaw is nearly undamped (`d33` = 0.105 N m s, `I_z - N_rdot` = 2.31
 /// kg m^2, `reference/vessels.md`): the 10 N m of eq. (19) held over one 1 s sample
 /// spin it up by 4.3 rad/s, and a plan free to do so ran tugs up to 30 rad/s in the
-/// closed loop (`docs/controller-design.md`, "Tug local MPCs"). An infinite limit
-/// builds no rows.
+/// closed loop (`docs/controller-design.md`, "Tug local MPCs"). A slack is at most
+/// 100 rad/s (any spin the plant can reach). An infinite limit builds no rows.
 #[must_use]
 pub fn tug_yaw_rate_rows(max_rate: f64, penalty: f64, per_step: usize, vessels: u8) -> SlotRows {
     let slots = if max_rate.is_finite() { 2 } else { 0 };
