@@ -650,17 +650,17 @@ impl Subproblem for CentralProblem {
                 (self
                     .ship_params
                     .clearance
-                    .bank(self.ship_params.waterway_rows))
+                    .single(self.ship_params.waterway_rows))
                 .rows(PER_STEP, SHIP),
                 (self
                     .tug_params
                     .clearance
-                    .bank(self.tug_params.waterway_rows))
+                    .single(self.tug_params.waterway_rows))
                 .rows(PER_STEP, TUG[0]),
                 (self
                     .tug_params
                     .clearance
-                    .bank(self.tug_params.waterway_rows))
+                    .single(self.tug_params.waterway_rows))
                 .rows(PER_STEP, TUG[1]),
             ],
             yaw: [

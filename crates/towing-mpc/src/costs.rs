@@ -89,11 +89,12 @@ impl ClearanceParams {
         )
     }
 
-    /// The same row kind for the bank ([`bank_terms`]): one slot when `on`, none
-    /// otherwise (a problem without a waterway keeps exactly the QP it had before the
-    /// bank rows existed).
+    /// The same row kind with one slot when `on`, none otherwise: the bank row
+    /// ([`bank_terms`]) or a tug's row about its own ship
+    /// ([`crate::TugMpcParams::own_ship_row`]). A problem without them keeps exactly
+    /// the QP it had before they existed.
     #[must_use]
-    pub fn bank(&self, on: bool) -> ClearanceParams {
+    pub fn single(&self, on: bool) -> ClearanceParams {
         ClearanceParams {
             max_obstacles: usize::from(on),
             ..*self
@@ -166,7 +167,12 @@ pub(crate) fn bank_terms<const N: usize>(
 /// closed loop (`docs/controller-design.md`, "Tug local MPCs"). A slack is at most
 /// 100 rad/s (any spin the plant can reach). An infinite limit builds no rows.
 #[must_use]
-pub fn tug_yaw_rate_rows(max_rate: f64, penalty: f64, per_step: usize, vessels: u8) -> SlotRows {
+pub(crate) fn tug_yaw_rate_rows(
+    max_rate: f64,
+    penalty: f64,
+    per_step: usize,
+    vessels: u8,
+) -> SlotRows {
     let slots = if max_rate.is_finite() { 2 } else { 0 };
     SlotRows::new(slots, (HORIZON, per_step), vessels, penalty, 100.0)
 }

@@ -351,7 +351,7 @@ impl Subproblem for ShipProblem {
             clearance: self.params.clearance.rows(4, ALL_VESSELS),
             motion: self.params.motion.rows(4, ALL_VESSELS),
             bank: (self.params.clearance)
-                .bank(self.params.waterway_rows)
+                .single(self.params.waterway_rows)
                 .rows(4, ALL_VESSELS),
         }
     }

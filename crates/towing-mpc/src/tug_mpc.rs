@@ -263,10 +263,10 @@ impl Subproblem for TugProblem {
         TugRows {
             clearance: self.params.clearance.rows(3, ALL_VESSELS),
             own_ship: (self.params.clearance)
-                .bank(self.params.own_ship_row)
+                .single(self.params.own_ship_row)
                 .rows(3, ALL_VESSELS),
             bank: (self.params.clearance)
-                .bank(self.params.waterway_rows)
+                .single(self.params.waterway_rows)
                 .rows(3, ALL_VESSELS),
             yaw: self.params.yaw_rate_rows(3, ALL_VESSELS),
         }
