@@ -2,7 +2,9 @@
 //! communication step 0.1 s. A development tool and a reference for the FMU runs.
 //!
 //! `cargo run --release -p towing-control --example closed_loop -- [stop_s] [scheme] [csv]`
-//! (`SCENARIO=file.toml` runs that scenario instead of the paper's)
+//! (`SCENARIO=file.toml` runs that scenario instead of the paper's; `DRIFT_LOG=1`
+//! prints the controller's state where each drift excursion over 30 deg begins; the
+//! other environment knobs are read in `main`).
 // A command-line tool: printing is its output.
 #![allow(clippy::print_stdout, clippy::print_stderr)]
 
@@ -219,6 +221,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         config.tuning.centralized.weight_force_rate = v;
         config.tuning.centralized.weight_moment_rate = v;
     }
+    if let Some(v) = env("SHIP_DRIFT") {
+        config.tuning.ship.motion.max_drift = v.to_radians();
+    }
+    if let Some(v) = env("SHIP_VMAX") {
+        config.tuning.ship.motion.max_speed = v;
+    }
+    if let Some(v) = env("RULE17_TCPA") {
+        config.tuning.guidance.colregs.rule17.tcpa = v;
+    }
+    if let Some(v) = env("THETA") {
+        config.tuning.guidance.altering_angle = v.to_radians();
+    }
     if let Some(v) = env("CENT_IT") {
         config.tuning.centralized.max_iterations = v as usize;
     }
@@ -247,11 +261,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut cpa: [(f64, f64, f64); towing_model::MAX_OBSTACLES] =
         [(f64::INFINITY, 0.0, 0.0); towing_model::MAX_OBSTACLES];
     let mut max_tug_r = 0.0f64;
+    // DRIFT_LOG: the context of each drift excursion (drift > 30 deg at >= 0.05 m/s).
+    let drift_log = std::env::var("DRIFT_LOG").is_ok();
+    let mut in_drift = false;
+    let mut last_report: Option<towing_control::SampleReport> = None;
     let wall = std::time::Instant::now();
     for n in 0..steps {
         let m = Measurement::from_world(&world);
         let step = controller.step(world.time(), &m)?;
         if let Some(r) = step.sample {
+            last_report = Some(r);
             times.push(r.compute_time * 1e3);
             iters.push(r.iterations);
             not_converged += usize::from(!r.converged);
@@ -298,6 +317,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             h,
         )?;
         max_tug_r = max_tug_r.max(world.tug(0).nu[2].abs().max(world.tug(1).nu[2].abs()));
+        if drift_log {
+            let s = world.ship();
+            let drifting =
+                s.nu[0].hypot(s.nu[1]) >= 0.05 && s.nu[1].atan2(s.nu[0]).abs() > 30f64.to_radians();
+            if drifting && !in_drift {
+                if let Some(r) = &last_report {
+                    eprintln!(
+                        "DRIFT t {:.1} psi {:.1} ref {:.1} floor {:?} alt {} sit {:?} u {:.3} v {:.3} r {:.3} F ({:.2},{:.2}) a ({:.1},{:.1}) wp {}",
+                        world.time(), s.eta[2].to_degrees(), r.reference[2].to_degrees(),
+                        r.heading_floor.map(|f| (f.to_degrees() * 10.0).round() / 10.0),
+                        r.guidance.altered, r.guidance.governing.and_then(|g| g.situation),
+                        s.nu[0], s.nu[1], s.nu[2], r.command.tension[0], r.command.tension[1],
+                        r.desired_angle[0].to_degrees(), r.desired_angle[1].to_degrees(), r.guidance.active_waypoint
+                    );
+                }
+            }
+            in_drift = drifting;
+        }
         if let Some(f) = csv.as_mut() {
             let s = world.ship();
             let (t1, t2) = (world.tug(0), world.tug(1));

@@ -309,8 +309,8 @@ struct Carried {
     nu_start: [[f64; 3]; 2],
     nu_end: [[f64; 3]; 2],
     fallbacks: u64,
-    /// Per obstacle slot: the ship's heading when an encounter began in which
-    /// the tow may not turn to port ([`TrackingParams::port_turn_margin`]).
+    /// Per obstacle slot: the highest heading reached since an encounter began in
+    /// which the tow may not turn to port ([`TrackingParams::port_turn_margin`]).
     port_turn_anchor: [Option<f64>; MAX_OBSTACLES],
     /// The reference course of the last sample ([`TrackingParams::course_rate`]);
     /// `None` before the first sample.
@@ -663,12 +663,13 @@ impl Controller {
             t.tracking.lookahead
         };
         let status = t.guidance.colregs.tow_status;
+        let heading_floor = self.heading_floor(m.ship[2]);
         let reference = self.reference(
             &m.ship,
-            guidance.active_waypoint,
-            target,
+            (guidance.active_waypoint, target),
             altered,
             lookahead,
+            heading_floor,
         );
         let situation: [Option<Situation>; MAX_OBSTACLES] =
             std::array::from_fn(|k| self.guidance.situation(k));
@@ -677,7 +678,7 @@ impl Controller {
             reference,
             situation,
             role: situation.map(|s| s.and_then(|s| role(s, status))),
-            heading_floor: self.heading_floor(m.ship[2]),
+            heading_floor,
         })
     }
 
@@ -834,10 +835,10 @@ impl Controller {
     fn reference(
         &mut self,
         ship: &[f64; 6],
-        active: usize,
-        target: Pose,
+        (active, target): (usize, Pose),
         altered: bool,
         lookahead: f64,
+        floor: Option<f64>,
     ) -> [f64; 3] {
         let points = self.guidance.route().points();
         let last = points.len() - 1;
@@ -870,7 +871,7 @@ impl Controller {
                 }
             }
         }
-        self.steer(ship, goal)
+        self.steer(ship, goal, floor)
     }
 
     /// The reference pose the MPC tracks, from the tracked point `goal`
@@ -882,13 +883,17 @@ impl Controller {
     /// 95 deg off its heading at once, which the tugs answered by dragging the ship
     /// sideways); it also stays within [`TrackingParams::course_lead`] of the
     /// ship's heading, so it leads a turn the ship is making but never lies abeam.
-    /// Beyond `los_distance` the tracked position is moved onto the reference course,
-    /// at the range of `goal` but no farther than the lookahead (or `los_distance`,
-    /// the larger), so position and heading ask for the same motion: ahead along the
+    /// Before that lead limit it is lifted onto the heading `floor`
+    /// ([`Controller::heading_floor`]) if it lies to port of it: the floor holds
+    /// the ship's head, and a reference course to port of it was answered by a
+    /// sideways drag (41 of the 50 drift failures of the centralized random
+    /// encounters, before). Beyond `los_distance` the tracked position is moved
+    /// onto the reference course, at the range of `goal` but no farther than the
+    /// lookahead (or `los_distance`, the larger), so position and heading ask for the same motion: ahead along the
     /// course at the cruise pull, never sideways, never faster for being far off.
     /// Within `los_distance` the tracked position stays, less any part of it abaft
     /// the ship's beam: the tow never gathers sternway to reach its reference.
-    fn steer(&mut self, ship: &[f64; 6], mut goal: [f64; 3]) -> [f64; 3] {
+    fn steer(&mut self, ship: &[f64; 6], mut goal: [f64; 3], floor: Option<f64>) -> [f64; 3] {
         let t = &self.config.tuning;
         let (dx, dy) = (goal[0] - ship[0], goal[1] - ship[1]);
         let range = dx.hypot(dy);
@@ -902,6 +907,11 @@ impl Controller {
         } else {
             wanted
         };
+        if let Some(f) = floor {
+            if wrap_angle(course - f) < 0.0 {
+                course = f;
+            }
+        }
         let lead = t.tracking.course_lead;
         if lead > 0.0 {
             course = turn_towards(ship[2], course, lead);
@@ -932,10 +942,16 @@ impl Controller {
     /// gives way (Rule 15) the tow alters to starboard; in a crossing in which
     /// it stands on it must not turn to port for the vessel on its port side
     /// (Rule 17(c)). In all three the tow therefore never turns to port: the
-    /// heading at the start of the encounter, less
+    /// highest heading reached since the encounter began, less
     /// [`TrackingParams::port_turn_margin`], is a floor for the ship's predicted
     /// headings until the target is past and clear (Rule 8(d); the guidance's
-    /// test) or the encounter ends. Held beyond past and clear, the floor
+    /// test) or the encounter ends: an alteration is not taken back, and a swing
+    /// past the intended course is not taken back either while the target is not
+    /// past (turning back is a turn to port, towards a target on the starboard bow
+    /// or across the bow of one on the port side; capping the floor at the course
+    /// steered gave a 15 deg port turn for a give-way target in imazu-07). The
+    /// reference course follows the floor ([`Controller::steer`]), so the head is
+    /// not held against the tracked point. Held beyond past and clear, the floor
     /// kept the ship's head to starboard while the reference course returned to
     /// the route, and the tugs dragged her sideways (drift 100 deg). Without it the
     /// centralized MPC, trading the heading error against the tugs' distance
@@ -1156,6 +1172,12 @@ pub fn mpc_params(
         // Scheme III, the paper's distance-cost-only baseline, keeps eq. (16) as printed.
         tug.max_yaw_rate = f64::INFINITY;
         tug.own_ship_row = false;
+        // Its tugs, without the yaw rows, spin (21 rad/s in the paper run); any
+        // change of the coordination's steps moves where a spin overflows, and with
+        // the trust regions reopened each sample its paper run fell back 7 times and
+        // the ship met a tug. It keeps the regions it had.
+        ship.scp.reopen = false;
+        tug.scp.reopen = false;
     }
     if !config.tuning.scheme.distance_cost() {
         ship.weight_distance = 0.0;

@@ -688,7 +688,7 @@ pub static PARAMETERS: &[Parameter] = &[
     Parameter {
         name: "tracking.port_turn_margin",
         old_name: Some("port_turn_margin"),
-        description: "While a head-on or crossing encounter lasts (schemes I, II), the ship's predicted heading stays to starboard of the highest heading reached since it began, less this margin (COLREGS Rules 8(d), 14, 15, 17(c): no turn to port); 2 deg (docs/assumptions.md)",
+        description: "While a head-on or crossing encounter lasts (schemes I, II), the ship's predicted heading stays to starboard of the highest heading reached since it began, less this margin (the reference course too) (COLREGS Rules 8(d), 14, 15, 17(c): no turn to port); 2 deg (docs/assumptions.md)",
         kind: Kind::Real {
             unit: "rad",
             min: Limit::AtLeast(0.0),

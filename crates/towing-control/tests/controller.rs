@@ -428,6 +428,32 @@ fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
     let r = c.sample(&m).unwrap();
     assert!((r.heading_floor.unwrap() - up).abs() < 1e-12);
 
+    // The reference course never lies to port of the floor (a head held to starboard
+    // while the reference lay to port of it was answered by a sideways drag), here
+    // after a swing of 60 deg: the floor follows it (no turn back to port towards the
+    // target before it is past), and so does the reference course.
+    let mut swung = m;
+    swung.ship[2] = psi + 60f64.to_radians();
+    let r = c.sample(&swung).unwrap();
+    let floor = r.heading_floor.unwrap();
+    assert!((floor - (swung.ship[2] - margin)).abs() < 1e-9);
+    for back in [m, swung] {
+        let r = c.sample(&back).unwrap();
+        assert!((r.heading_floor.unwrap() - floor).abs() < 1e-9);
+        // At most `course_lead` ahead of the ship's head: on the floor, or turning
+        // towards it at that lead.
+        let lead = ControllerConfig::new(scenario.clone())
+            .tuning
+            .tracking
+            .course_lead;
+        let wanted = floor.min(back.ship[2] + lead);
+        let course = r.reference[2];
+        assert!(
+            towing_model::wrap_angle(course - wanted) >= -1e-12,
+            "{course} vs {wanted}"
+        );
+    }
+
     // The target gone: no floor.
     let mut clear = m;
     clear.obstacles[3].kind = ObstacleKind::None;

@@ -933,10 +933,8 @@ impl Centralized {
         let data = CentralData::of(input);
         let settings = *self.settings();
         // A trust region shrunk by the previous sample's last steps would make
-        // this sample crawl from the start: at least the initial radius.
-        if self.scp.trust_region().radius() < settings.scp.initial_radius {
-            self.scp.trust_region_mut().reset();
-        }
+        // this sample crawl from the start.
+        self.scp.trust_region_mut().reopen();
         let mut iterations = 0;
         let mut failed_steps = 0;
         let mut converged = false;

@@ -27,6 +27,9 @@ pub struct ScpSettings {
     pub grow: f64,
     /// Shrink factor (in (0, 1)).
     pub shrink: f64,
+    /// Whether [`TrustRegion::reopen`] reopens the region (the optimizers call it
+    /// at the start of each control sample).
+    pub reopen: bool,
 }
 
 impl Default for ScpSettings {
@@ -40,6 +43,7 @@ impl Default for ScpSettings {
             poor: 0.25,
             grow: 2.0,
             shrink: 0.25,
+            reopen: true,
         }
     }
 }
@@ -137,6 +141,16 @@ impl TrustRegion {
         self.radius = self.settings.initial_radius;
     }
 
+    /// At least the initial radius again, with [`ScpSettings::reopen`]: a new
+    /// problem (the next control sample) starts with a fresh trust region (Conn,
+    /// Gould, Toint 2000, Algorithm 6.1.1, step 0), whatever the last one shrank
+    /// it to.
+    pub fn reopen(&mut self) {
+        if self.settings.reopen {
+            self.radius = self.radius.max(self.settings.initial_radius);
+        }
+    }
+
     /// Judges a step: returns `(accepted, ratio)` and updates the radius. A
     /// predicted decrease `<= 1e-12 (1 + |J|)` means the plan is (numerically)
     /// stationary in the trust region: the step is not taken (ratio 1, radius
@@ -176,6 +190,26 @@ mod tests {
         let r1 = tr.radius();
         let (acc, _) = tr.judge(10.0, 11.0, 1.0);
         assert!(!acc && tr.radius() < r1);
+    }
+
+    /// A new sample's problem starts with the region open again: a radius shrunk
+    /// to the minimum goes back to the initial one, a larger one is kept.
+    #[test]
+    fn reopen_restores_at_least_the_initial_radius() {
+        let s = ScpSettings::default();
+        let mut tr = TrustRegion::new(s);
+        while tr.radius() > s.min_radius {
+            tr.fail();
+        }
+        tr.reopen();
+        assert_eq!(tr.radius(), s.initial_radius);
+        tr.set_radius(s.max_radius);
+        tr.reopen();
+        assert_eq!(tr.radius(), s.max_radius);
+        let mut kept = TrustRegion::new(ScpSettings { reopen: false, ..s });
+        kept.set_radius(s.min_radius);
+        kept.reopen();
+        assert_eq!(kept.radius(), s.min_radius);
     }
 
     #[test]
