@@ -949,7 +949,7 @@ impl Controller {
     /// past the intended course is not taken back either while the target is not
     /// past (turning back is a turn to port, towards a target on the starboard bow
     /// or across the bow of one on the port side; capping the floor at the course
-    /// steered gave a 15 deg port turn for a give-way target in imazu-07). The
+    /// steered gave a 15 deg port turn for a give-way target in a suite encounter). The
     /// reference course follows the floor ([`Controller::steer`]), so the head is
     /// not held against the tracked point. Held beyond past and clear, the floor
     /// kept the ship's head to starboard while the reference course returned to

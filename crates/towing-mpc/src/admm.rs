@@ -544,7 +544,7 @@ impl Core<'_> {
         // The trust regions reopened, as the centralized problem's: kept at the
         // 1e-4 a hard sample had shrunk it to, the ship's plan hardly moved for the
         // first ten iterations of every later sample while the tugs' plans and the
-        // multipliers ran away from it (random-12-0004: r_pri up to 7 m, tug 2
+        // multipliers ran away from it (a random encounter: r_pri up to 7 m, tug 2
         // driven into the ship). The tugs' too: with the ship's alone, 22 instead
         // of 26 of the first 100 random encounters passed.
         self.ship.trust_region_mut().reopen();
