@@ -437,15 +437,15 @@ fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
     let r = c.sample(&swung).unwrap();
     let floor = r.heading_floor.unwrap();
     assert!((floor - (swung.ship[2] - margin)).abs() < 1e-9);
+    let lead = ControllerConfig::new(scenario.clone())
+        .tuning
+        .tracking
+        .course_lead;
     for back in [m, swung] {
         let r = c.sample(&back).unwrap();
         assert!((r.heading_floor.unwrap() - floor).abs() < 1e-9);
         // At most `course_lead` ahead of the ship's head: on the floor, or turning
         // towards it at that lead.
-        let lead = ControllerConfig::new(scenario.clone())
-            .tuning
-            .tracking
-            .course_lead;
         let wanted = floor.min(back.ship[2] + lead);
         let course = r.reference[2];
         assert!(

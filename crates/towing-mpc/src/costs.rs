@@ -152,9 +152,25 @@ pub(crate) fn bank_terms<const N: usize>(
     let (d, grad) = waterway.lane.distance_and_gradient(at.pos);
     let clearance = waterway.lane.half_width - d;
     let margin = waterway.margin[vessel];
-    quad.value += penalty * (margin - clearance).max(0.0);
+    soft_row(quad, rows, (at.h, 0), (clearance, margin, penalty), || {
+        at.row([-grad[0], -grad[1]])
+    });
+}
+
+/// One soft row `value + row^T du >= bound - s`, slot `j` of sample `h`: its exact
+/// L1 penalty `penalty max(0, bound - value)` in the merit and, with `rows`, the
+/// linearised row (built only then). The one place the bank, yaw-rate and motion
+/// rows write themselves.
+fn soft_row<const N: usize>(
+    quad: &mut QuadModel,
+    rows: Option<&mut SlotRows>,
+    (h, j): (usize, usize),
+    (value, bound, penalty): (f64, f64, f64),
+    row: impl FnOnce() -> [f64; N],
+) {
+    quad.value += penalty * (bound - value).max(0.0);
     if let Some(r) = rows {
-        r.record(at.h, 0, clearance, margin, &at.row([-grad[0], -grad[1]]));
+        r.record(h, j, value, bound, &row());
     }
 }
 
@@ -191,12 +207,13 @@ pub(crate) fn tug_yaw_rate_terms<const N: usize>(
         return;
     }
     for (j, sign) in [1.0, -1.0].into_iter().enumerate() {
-        let value = sign * r;
-        quad.value += penalty * (-max_rate - value).max(0.0);
-        if let Some(slots) = rows.as_deref_mut() {
-            let row: [f64; N] = std::array::from_fn(|k| sign * dr[k]);
-            slots.record(h, j, value, -max_rate, &row);
-        }
+        soft_row::<N>(
+            quad,
+            rows.as_deref_mut(),
+            (h, j),
+            (sign * r, -max_rate, penalty),
+            || std::array::from_fn(|k| sign * dr[k]),
+        );
     }
 }
 
@@ -295,11 +312,13 @@ impl MotionLimits {
         }
         for (j, (bound, g)) in self.limits().into_iter().enumerate() {
             let value = g[0] * x[3] + g[1] * x[4];
-            quad.value += self.penalty * (bound - value).max(0.0);
-            if let Some(r) = rows.as_deref_mut() {
-                let row: [f64; N] = std::array::from_fn(|k| g[0] * dx[3][k] + g[1] * dx[4][k]);
-                r.record(h, j, value, bound, &row);
-            }
+            soft_row::<N>(
+                quad,
+                rows.as_deref_mut(),
+                (h, j),
+                (value, bound, self.penalty),
+                || std::array::from_fn(|k| g[0] * dx[3][k] + g[1] * dx[4][k]),
+            );
         }
     }
 }
