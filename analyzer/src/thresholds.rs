@@ -39,6 +39,10 @@ pub struct Thresholds {
     pub waterway_tolerance_m: f64,
     /// Give-way: least course alteration to starboard that counts as action, deg.
     pub give_way_turn_deg: f64,
+    /// Give-way: an action is still held while the ship's head, to starboard of its
+    /// heading at detection, comes round to starboard at this yaw rate or more, deg/s
+    /// (the tow gathering way as she alters: docs/analyzer.md).
+    pub give_way_turn_rate_deg_s: f64,
     /// Give-way: the way is off at this surge speed or less, m/s.
     pub way_off_surge_m_s: f64,
     /// Give-way: no vessel of the tow crosses ahead of a give-way target closer than
@@ -73,6 +77,7 @@ impl Default for Thresholds {
             astern_max_m_s: 0.03,
             waterway_tolerance_m: 0.0,
             give_way_turn_deg: 10.0,
+            give_way_turn_rate_deg_s: 1.0,
             way_off_surge_m_s: 0.05,
             cross_ahead_min_m: 7.0,
             head_on_turn_deg: 10.0,
@@ -88,7 +93,7 @@ impl Default for Thresholds {
 impl Thresholds {
     /// Every threshold with its name, in declaration order.
     #[must_use]
-    pub fn entries(&self) -> [(&'static str, f64); 19] {
+    pub fn entries(&self) -> [(&'static str, f64); 20] {
         [
             ("progress_min_m", self.progress_min_m),
             ("destination_radius_m", self.destination_radius_m),
@@ -101,6 +106,7 @@ impl Thresholds {
             ("astern_max_m_s", self.astern_max_m_s),
             ("waterway_tolerance_m", self.waterway_tolerance_m),
             ("give_way_turn_deg", self.give_way_turn_deg),
+            ("give_way_turn_rate_deg_s", self.give_way_turn_rate_deg_s),
             ("way_off_surge_m_s", self.way_off_surge_m_s),
             ("cross_ahead_min_m", self.cross_ahead_min_m),
             ("head_on_turn_deg", self.head_on_turn_deg),

@@ -131,17 +131,21 @@ fn run(
     let g = geometry();
     let mut seamanship = Seamanship::new(&g, &Thresholds::default());
     let mut pos = [0.0, 0.0];
+    let mut prev_psi: Option<f64> = None;
     let n = (t_end / DT).round() as usize;
     for k in 0..=n {
         let t = k as f64 * DT;
         let (psi_deg, u, v) = motion(t, pos);
+        let psi = psi_deg.to_radians();
+        // The yaw rate over the step ending at `t` (the heading script's slope).
+        let r = prev_psi.replace(psi).map_or(0.0, |p| (psi - p) / DT);
         let mut ship = Vessel {
             x: 0.0,
             y: 0.0,
-            psi: psi_deg.to_radians(),
+            psi,
             u,
             v,
-            r: 0.0,
+            r,
         };
         if k > 0 {
             let vel = ship.vel_n();
@@ -346,6 +350,47 @@ fn seamanship_give_way_given_up_before_the_target_is_past() {
     assert_eq!(rule8[0].t_s, Some(450.5));
     // Tug 2 then crosses the target's course line ahead of it, at under 7 m.
     assert!(metrics(&why).contains(&"rule15_give_way"), "{why:?}");
+}
+
+/// Stopped from 300 s as [`stop_until`]; from 450 s at cruise again, bringing her head
+/// round to starboard at 2 deg/s to `to_deg`.
+fn resume_swinging(to_deg: f64) -> impl Fn(f64, [f64; 2]) -> (f64, f64, f64) {
+    move |t, p| {
+        if t > 450.0 {
+            ((2.0 * (t - 450.0)).min(to_deg), CRUISE, 0.0)
+        } else {
+            stop_until(450.0)(t, p)
+        }
+    }
+}
+
+#[test]
+fn seamanship_gathering_way_while_altering_to_starboard_holds_the_give_way() {
+    // Resumes at 450 s as before, but bringing her head round to starboard at 2 deg/s to
+    // 30 deg: for the first 5 s she is neither 10 deg round nor stopped, and that is an
+    // alteration under way, not the action given up. She passes astern of the target.
+    let r = run(
+        1000.0,
+        resume_swinging(30.0),
+        no_offset,
+        &[crossing_from_starboard()],
+    );
+    let target = &r.rules.targets[0];
+    assert_eq!(target.action.as_deref(), Some("way off"));
+    assert_eq!(target.given_up, None, "{target:?}");
+    assert!(target.t_past_and_clear_s.is_some(), "{target:?}");
+    let why = verdict(&r);
+    assert!(!metrics(&why).contains(&"rule8_past_and_clear"), "{why:?}");
+    // The same resumption with the swing stopping at 5 deg is given up when the swing
+    // ends (the head is neither 10 deg round nor still coming round).
+    let r = run(
+        1000.0,
+        resume_swinging(5.0),
+        no_offset,
+        &[crossing_from_starboard()],
+    );
+    let g = r.rules.targets[0].given_up.expect("given up");
+    assert!(g.t_s > 452.0 && g.t_s <= 453.0, "{g:?}");
 }
 
 #[test]

@@ -143,6 +143,7 @@ pub const INFO: ModelInfo = ModelInfo {
         RealType::new("YawRateWeight", "s2/rad2", None, (0, 0, 2, -2)),
         RealType::new("ForceWeight", "1/N2", None, (-2, -2, 4, 0)),
         RealType::new("MomentWeight", "1/(N.m)2", None, (-2, -4, 4, 0)),
+        RealType::new("Acceleration", "m/s2", None, (0, 1, -2, 0)),
     ],
     fmu_state: true,
 };

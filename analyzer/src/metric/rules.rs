@@ -13,7 +13,9 @@
 //! - give-way (Rule 16; head-on, crossing give-way, overtaking): action before the CPA, a
 //!   course alteration of at least `give_way_turn_deg` to starboard from the heading at
 //!   detection or the way off (surge <= `way_off_surge_m_s`); held until the target is
-//!   past and clear (Rule 8(d)), else "given up" (`rule8_past_and_clear`);
+//!   past and clear (Rule 8(d)), else "given up" (`rule8_past_and_clear`); a head to
+//!   starboard of its detection heading still coming round at `give_way_turn_rate_deg_s`
+//!   or more holds it too (the tow gathering way as she alters);
 //! - no vessel of the tow crosses ahead of a give-way target closer than
 //!   `cross_ahead_min_m` (Rule 15: "avoid crossing ahead"; the same check for head-on and
 //!   overtaking under their rule);
@@ -337,9 +339,15 @@ impl Target {
     /// Rule 16 and 8(d): the first action, and its release before past and clear.
     fn give_way_action(&mut self, t: f64, ship: &Vessel, range: f64, beta: f64, th: &Thresholds) {
         let Some(det) = self.det else { return };
-        let turned = wrap(ship.psi - det.psi).to_degrees() >= th.give_way_turn_deg;
+        let turn = wrap(ship.psi - det.psi).to_degrees();
+        let turned = turn >= th.give_way_turn_deg;
         let way_off = ship.u <= th.way_off_surge_m_s;
         let acting = turned || way_off;
+        // An alteration to starboard under way: the head already to starboard of its
+        // heading at detection and still coming round. It holds an action (the tow
+        // gathering way while she brings her head round is not giving way up), it is
+        // not yet one (Rule 16 needs the turn or the way off).
+        let swinging = turn > 0.0 && ship.r.to_degrees() >= th.give_way_turn_rate_deg_s;
         if acting && self.r.t_action_s.is_none() {
             self.r.t_action_s = Some(t);
             self.r.action = Some(
@@ -351,7 +359,7 @@ impl Target {
                 .to_owned(),
             );
         }
-        let released = self.acting && !acting;
+        let released = self.acting && !acting && !swinging;
         if released && self.r.t_past_and_clear_s.is_none() && self.r.given_up.is_none() {
             self.r.given_up = Some(GiveUp {
                 t_s: t,
@@ -359,7 +367,7 @@ impl Target {
                 bearing_deg: beta,
             });
         }
-        self.acting = acting;
+        self.acting = acting || (self.acting && swinging);
     }
 
     /// Rule 15: a vessel of the tow crossing the target's course line ahead of it, close.

@@ -199,6 +199,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(v) = env("GW_LA") {
         config.tuning.tracking.give_way_lookahead = v;
     }
+    if let Some(v) = env("GW_SURGE") {
+        config.tuning.tracking.give_way_surge = v;
+    }
     if let Some(v) = env("TUG_NMAX") {
         config.tuning.tug.thrust_limit[2] = v;
     }
@@ -303,6 +306,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     r.command.tug_thrust[0].map(|v| (v * 100.0).round() / 100.0), r.command.tug_thrust[1].map(|v| (v * 100.0).round() / 100.0), r.iterations,
                     m.ship[0], m.ship[1], m.ship[2].to_degrees(), m.ship[3], m.ship[4], m.ship[5]
                 );
+            }
+            if std::env::var("GOV").is_ok() {
+                if let Some(g) = r.guidance.governing {
+                    eprintln!("GOV t {:.1} alt {} idx {} range {:.2} d9 {:.2} sit {:?} act {:?} det {} pc {} crossed {} man {:?} beta {:?}",
+                        world.time(), r.guidance.altered, g.index, g.range, g.distance_eq9, g.situation, g.action, g.detected, g.past_and_clear, g.crossed, g.manoeuvre,
+                        g.encounter.map(|e| (e.bearing.to_degrees() * 10.0).round() / 10.0));
+                }
             }
             if let Some(why) = r.fallback {
                 eprintln!("t = {:.1}: fallback: {why}", world.time());

@@ -415,6 +415,7 @@ fn sample_json(s: &Recorded) -> Value {
         "previous": {"ship": i.previous.ship, "tugs": i.previous.tugs},
         "reference": i.reference,
         "heading_floor": i.heading_floor,
+        "max_surge": i.max_surge,
         "obstacles": i.obstacles(),
         "distance_cost_off": i.distance_cost_off,
         "loop": {"ship": s.ship, "tugs": s.tugs, "fallback": s.fallback},
@@ -492,6 +493,13 @@ fn input_from(v: &Value, k: usize) -> Res<MpcInput> {
                 .ok_or_else(|| format!("{what}.heading_floor: not a number"))?,
         ),
     };
+    let max_surge = match &v["max_surge"] {
+        Value::Null => None,
+        x => Some(
+            x.as_f64()
+                .ok_or_else(|| format!("{what}.max_surge: not a number"))?,
+        ),
+    };
     let input = SampleInput {
         ship: floats(&v["ship"], &format!("{what}.ship"))?,
         tugs: nested(&v["tugs"], &format!("{what}.tugs"))?,
@@ -505,6 +513,7 @@ fn input_from(v: &Value, k: usize) -> Res<MpcInput> {
             .as_u64()
             .ok_or_else(|| format!("{what}.distance_cost_off: not an unsigned integer"))?,
         heading_floor,
+        max_surge,
         waterway: None,
     };
     Ok(MpcInput::of(&input))

@@ -187,6 +187,22 @@ pub struct TrackingParams {
     /// gives way: a nearer tracked point slackens the tow's speed (COLREGS Rule
     /// 8(e), Rule 16) so the target crosses ahead and the tow passes astern.
     pub give_way_lookahead: f64,
+    /// The tow keeps the way off while giving way in a crossing (`give_way_surge`,
+    /// `give_way_deceleration`); `false` (the default): the motion limits' own surge
+    /// limit only (`docs/assumptions.md`: with it the random encounters pass more
+    /// often, but the paper scenario's distributed scheme I breaks its 10 %
+    /// elongation expectation).
+    pub give_way_way_off: bool,
+    /// While the route is altered for a crossing in which the tow gives way, the
+    /// ship's plan does not gather way (its surge stays at or below the measured
+    /// surge) and, once she has slowed to this speed (m/s), keeps the way off
+    /// (COLREGS Rule 8(e)) until the encounter is over, whatever the tracked point
+    /// asks.
+    pub give_way_surge: f64,
+    /// The deceleration (m/s^2) at which the tow takes the way off while giving way
+    /// in a crossing: each sample the plan's surge stays at or below the measured
+    /// surge less this times the sample time, until it reaches `give_way_surge`.
+    pub give_way_deceleration: f64,
     /// Line-of-sight distance (m): while the ship is farther than this from the
     /// tracked point, the reference heading is the bearing from the ship to it
     /// (line of sight, Fossen 2011, section 10.3.2) instead of the waypoint's
@@ -211,7 +227,9 @@ pub struct TrackingParams {
 }
 
 impl Default for TrackingParams {
-    /// `lookahead = 3.5 m`, `give_way_lookahead = 0 m`, `los_distance = 2.5 m`
+    /// `lookahead = 3.5 m`, `give_way_lookahead = 0 m`, `give_way_surge = 0.04 m/s`,
+    /// `give_way_deceleration = 0.005 m/s^2`,
+    /// `los_distance = 2.5 m`
     /// (two CyberShip II lengths), `port_turn_margin = 2 deg` (the course change
     /// evaluators count as none, `docs/colregs.md`);
     /// why in `docs/assumptions.md`.
@@ -219,6 +237,9 @@ impl Default for TrackingParams {
         TrackingParams {
             lookahead: 3.5,
             give_way_lookahead: 0.0,
+            give_way_way_off: false,
+            give_way_surge: 0.04,
+            give_way_deceleration: 0.005,
             los_distance: 2.5,
             port_turn_margin: 2f64.to_radians(),
             course_rate: 1.5f64.to_radians(),

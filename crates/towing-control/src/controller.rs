@@ -189,6 +189,7 @@ struct Guided {
     situation: [Option<Situation>; MAX_OBSTACLES],
     role: [Option<Role>; MAX_OBSTACLES],
     heading_floor: Option<f64>,
+    max_surge: Option<f64>,
 }
 
 /// What one [`Controller::step`] did.
@@ -589,6 +590,7 @@ impl Controller {
             obstacles: &self.mpc_obstacles[..n_obstacles],
             distance_cost_off,
             heading_floor: guided.heading_floor,
+            max_surge: guided.max_surge,
             waterway: (self.waterway.as_ref()).map(|(lane, margin)| Waterway {
                 lane,
                 margin: *margin,
@@ -663,6 +665,17 @@ impl Controller {
             t.tracking.lookahead
         };
         let status = t.guidance.colregs.tow_status;
+        // Rule 8(e): giving way in a crossing, the tow takes the way off at a
+        // bounded deceleration and keeps it off: the plan's surge stays at or
+        // below the measured surge less `give_way_deceleration` T_s, and at or
+        // below `give_way_surge` once she has slowed to it. Off the altered leg
+        // the tracked point lies abeam or ahead and drew her ahead again before
+        // the target was past; a sudden cap at cruise speed made her crab (drift
+        // 37-55 deg) as she slowed and turned.
+        let max_surge = (giving_way && t.tracking.give_way_way_off).then(|| {
+            let slowing = m.ship[3] - t.tracking.give_way_deceleration * t.prediction.sample_time;
+            t.tracking.give_way_surge.max(slowing)
+        });
         let heading_floor = self.heading_floor(m.ship[2]);
         let reference = self.reference(
             &m.ship,
@@ -679,6 +692,7 @@ impl Controller {
             situation,
             role: situation.map(|s| s.and_then(|s| role(s, status))),
             heading_floor,
+            max_surge,
         })
     }
 

@@ -35,6 +35,8 @@ pub struct MpcInput {
     pub distance_cost_off: u64,
     /// The heading floor (rad), if any.
     pub heading_floor: Option<f64>,
+    /// The surge cap (m/s), if any ([`SampleInput::max_surge`]).
+    pub max_surge: Option<f64>,
 }
 
 impl MpcInput {
@@ -64,6 +66,7 @@ impl MpcInput {
             n_obstacles: n,
             distance_cost_off: input.distance_cost_off,
             heading_floor: input.heading_floor,
+            max_surge: input.max_surge,
         }
     }
 
@@ -84,6 +87,7 @@ impl MpcInput {
             obstacles: self.obstacles(),
             distance_cost_off: self.distance_cost_off,
             heading_floor: self.heading_floor,
+            max_surge: self.max_surge,
             waterway: None,
         }
     }
@@ -119,6 +123,7 @@ mod tests {
             obstacles: &obstacles,
             distance_cost_off: 0b10,
             heading_floor: Some(0.2),
+            max_surge: Some(0.04),
             waterway: None,
         };
         let owned = MpcInput::of(&input);
@@ -129,6 +134,7 @@ mod tests {
             (input.ship, input.tugs, input.previous, input.reference)
         );
         assert_eq!(back.heading_floor, Some(0.2));
+        assert_eq!(back.max_surge, Some(0.04));
         assert_eq!(back.distance_cost_off, 0b10);
     }
 }

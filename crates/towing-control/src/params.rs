@@ -814,6 +814,63 @@ pub static PARAMETERS: &[Parameter] = &[
             set: |t, v| t.tracking.course_lead = v,
         },
     },
+    Parameter {
+        name: "tracking.give_way_way_off",
+        old_name: None,
+        description: "true: while the route is altered for a crossing in which the tow gives way, she takes the way off (tracking.give_way_deceleration) and keeps it off (tracking.give_way_surge) until the encounter is over (COLREGS Rule 8(e)); false (default): the motion limits only (docs/assumptions.md: more random encounters pass with it, but the paper scenario's distributed scheme I exceeds its 10 % elongation expectation)",
+        kind: Kind::Boolean {
+            get: |t| t.tracking.give_way_way_off,
+            set: |t, v| t.tracking.give_way_way_off = v,
+        },
+    },
+    Parameter {
+        name: "tracking.give_way_surge",
+        old_name: None,
+        description: "While the route is altered for a crossing in which the tow gives way, she takes the way off (tracking.give_way_deceleration) down to this surge and keeps it off (COLREGS Rule 8(e)) until the encounter is over; 0.04 m/s, under the 0.05 m/s at which the analyzer counts the way off (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "m/s",
+            min: Limit::Above(0.0),
+            max: Limit::None,
+            get: |t| t.tracking.give_way_surge,
+            set: |t, v| t.tracking.give_way_surge = v,
+        },
+    },
+    Parameter {
+        name: "tracking.give_way_deceleration",
+        old_name: None,
+        description: "The deceleration at which the tow takes the way off while giving way in a crossing: each sample the ship's plan keeps its surge at or below the measured surge less this times the sample time, down to tracking.give_way_surge; 0.005 m/s^2, cruise to 0.04 m/s in about 14 s (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "m/s2",
+            min: Limit::AtLeast(0.0),
+            max: Limit::None,
+            get: |t| t.tracking.give_way_deceleration,
+            set: |t, v| t.tracking.give_way_deceleration = v,
+        },
+    },
+    Parameter {
+        name: "guidance.rule17_tcpa",
+        old_name: None,
+        description: "Rule 17(a)(ii): a stand-on tow acts once the TCPA of a target still closing to under guidance.rule17_dcpa is at most this; 30 s (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "s",
+            min: Limit::Above(0.0),
+            max: Limit::None,
+            get: |t| t.guidance.colregs.rule17.tcpa,
+            set: |t, v| t.guidance.colregs.rule17.tcpa = v,
+        },
+    },
+    Parameter {
+        name: "guidance.rule17_dcpa",
+        old_name: None,
+        description: "Rule 17(a)(ii): the DCPA (ship centre to target centre) below which the give-way vessel is deemed not to have acted; 2.5 m, about two ship lengths (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "m",
+            min: Limit::Above(0.0),
+            max: Limit::None,
+            get: |t| t.guidance.colregs.rule17.dcpa,
+            set: |t, v| t.guidance.colregs.rule17.dcpa = v,
+        },
+    },
 ];
 
 #[cfg(test)]

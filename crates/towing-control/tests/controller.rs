@@ -387,13 +387,12 @@ fn absurd_speeds_fall_back_with_a_finite_report() {
     }
 }
 
-#[test]
-fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
-    let (scenario, mut m) = paper_measurement();
+/// A target ship 5 m ahead of the ship and 3 m to starboard, heading across her bow to
+/// port at 0.07 m/s, closing: a crossing in which the tow gives way.
+fn crossing_from_starboard(m: &Measurement) -> ObstacleSlot {
     let psi = m.ship[2];
-    // 5 m ahead and 3 m to starboard, heading across the bow to port, closing.
     let (fwd, stb) = (5.0, 3.0);
-    let target = ObstacleSlot {
+    ObstacleSlot {
         x: m.ship[0] + fwd * psi.cos() - stb * psi.sin(),
         y: m.ship[1] + fwd * psi.sin() + stb * psi.cos(),
         psi: psi - std::f64::consts::FRAC_PI_2,
@@ -401,7 +400,60 @@ fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
         length: 1.48,
         width: 0.48,
         kind: ObstacleKind::VesselEllipse,
-    };
+    }
+}
+
+/// Rule 8(e): giving way in a crossing, the tow takes the way off at a bounded
+/// deceleration and keeps it off: the plan's surge is capped at the measured surge less
+/// `tracking.give_way_deceleration` T_s, and at `tracking.give_way_surge` once she is
+/// slower. Without the encounter, or without `tracking.give_way_way_off` (the default),
+/// there is no cap.
+#[test]
+fn giving_way_in_a_crossing_the_plan_does_not_gather_way() {
+    let (scenario, mut m) = paper_measurement();
+    let target = crossing_from_starboard(&m);
+    let mut config = ControllerConfig::new(scenario.clone());
+    let mut off = Controller::new(config.clone()).unwrap();
+    let original = m.obstacles[3];
+    m.obstacles[3] = target;
+    let r = off.sample(&m).unwrap();
+    assert_eq!(r.situation[3], Some(Situation::CrossingGiveWay));
+    assert_eq!(
+        off.last_mpc_input().unwrap().max_surge,
+        None,
+        "off by default"
+    );
+    m.obstacles[3] = original;
+    config.tuning.tracking.give_way_way_off = true;
+    let cap = config.tuning.tracking.give_way_surge;
+    let slowing =
+        config.tuning.tracking.give_way_deceleration * config.tuning.prediction.sample_time;
+    assert!(slowing > 0.0);
+    let mut open_water = Controller::new(config.clone()).unwrap();
+    open_water.sample(&m).unwrap();
+    assert_eq!(open_water.last_mpc_input().unwrap().max_surge, None);
+
+    m.obstacles[3] = target;
+    let mut c = Controller::new(config).unwrap();
+    for (u, expected) in [(0.1, 0.1 - slowing), (0.01, cap), (0.07, 0.07 - slowing)] {
+        m.ship[3] = u;
+        let r = c.sample(&m).unwrap();
+        assert_eq!(r.situation[3], Some(Situation::CrossingGiveWay));
+        assert!(r.guidance.altered);
+        let got = c.last_mpc_input().unwrap().max_surge;
+        let got = got.expect("a cap while giving way");
+        assert!(
+            (got - expected).abs() < 1e-12,
+            "surge {u}: cap {got}, expected {expected}"
+        );
+    }
+}
+
+#[test]
+fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
+    let (scenario, mut m) = paper_measurement();
+    let psi = m.ship[2];
+    let target = crossing_from_starboard(&m);
     m.obstacles[3] = target;
     let margin = ControllerConfig::new(scenario.clone())
         .tuning

@@ -48,6 +48,7 @@ fn bench(c: &mut Criterion) {
             obstacles: &obstacles,
             distance_cost_off: 0,
             heading_floor: None,
+            max_surge: None,
             waterway: None,
         };
         let mut admm = Admm::from_scenario(
@@ -93,6 +94,7 @@ fn bench(c: &mut Criterion) {
             obstacles,
             distance_cost_off: 0,
             heading_floor: None,
+            max_surge: None,
             waterway: None,
         };
         let mut central = Centralized::from_scenario(

@@ -79,6 +79,7 @@ fn bench(c: &mut Criterion) {
         obstacles: &obstacles,
         distance_cost_off: 0,
         heading_floor: None,
+        max_surge: None,
         waterway: None,
     };
     let ship_plan = [[0.5, 1.0, 0.0, 0.0]; HORIZON];

@@ -210,6 +210,10 @@ pub struct SampleInput<'a> {
     /// no turn to port while giving way or standing on
     /// ([`crate::ShipMpcParams::port_turn_weight`]); `None`: no such limit.
     pub heading_floor: Option<f64>,
+    /// The largest surge speed (m/s) the ship's plan may take over the horizon, below
+    /// [`crate::MotionLimits::max_speed`] (the way off while giving way:
+    /// [`crate::MotionLimits::capped`]); `None`: the motion limits' own.
+    pub max_surge: Option<f64>,
     /// The waterway every vessel of the tow keeps inside ([`Waterway`]); `None`: open
     /// water.
     pub waterway: Option<Waterway<'a>>,
@@ -572,6 +576,7 @@ impl Core<'_> {
                 obstacles: input.obstacles,
                 distance_cost_off: input.distance_cost_off,
                 heading_floor: input.heading_floor,
+                max_surge: input.max_surge,
                 waterway: input.waterway,
             });
             last_steps = [steps[0], steps[1], ship];

@@ -450,7 +450,9 @@ impl CentralProblem {
             h + 1 == HORIZON,
             input.heading_floor,
         );
-        sp.motion.terms(quad, motion, h, x, rows);
+        sp.motion
+            .capped(input.max_surge)
+            .terms(quad, motion, h, x, rows);
         let at = At {
             h,
             pos: [x[0], x[1]],

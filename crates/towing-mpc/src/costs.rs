@@ -286,6 +286,16 @@ impl MotionLimits {
         )
     }
 
+    /// These limits with the surge limit lowered to `max_surge` (when given and
+    /// lower): the way off while the tow gives way (`docs/colregs.md`).
+    #[must_use]
+    pub fn capped(&self, max_surge: Option<f64>) -> MotionLimits {
+        MotionLimits {
+            max_speed: max_surge.map_or(self.max_speed, |m| m.min(self.max_speed)),
+            ..*self
+        }
+    }
+
     /// The rows' values `g(x)`, bounds `b` (`g >= b`) and `dg/d(u, v)`.
     fn limits(&self) -> [(f64, [f64; 2]); 4] {
         let t = self.max_drift.tan();

@@ -244,6 +244,8 @@ pub struct ShipStepData<'a> {
     /// The lowest heading the ship may take over the horizon (rad), from
     /// COLREGS: no turn to port while the tow gives way or stands on.
     pub heading_floor: Option<f64>,
+    /// The largest surge speed (m/s) of the plan ([`crate::SampleInput::max_surge`]).
+    pub max_surge: Option<f64>,
     /// The waterway ([`crate::SampleInput::waterway`]).
     pub waterway: Option<Waterway<'a>>,
 }
@@ -492,7 +494,10 @@ fn accumulate(
             data.heading_floor,
         );
         let motion = soft.as_deref_mut().map(|r| &mut r.motion);
-        params.motion.terms(quad, motion, h, x, &rows);
+        params
+            .motion
+            .capped(data.max_surge)
+            .terms(quad, motion, h, x, &rows);
         for i in 0..2 {
             let (f, jac) = formation.tug_reference_linearised(eta, plan[h][2 + i], i);
             let g = data.tug_poses[i][h];
@@ -575,6 +580,7 @@ mod tests {
             obstacles: &[],
             distance_cost_off: 0,
             heading_floor: None,
+            max_surge: None,
             waterway: None,
         }
     }
@@ -682,6 +688,33 @@ mod tests {
             assert!(with < 1e-3, "{reference:?}: {with} m/s beyond the limits");
             assert!(without > 5e-3, "{reference:?}: {without} m/s without them");
         }
+    }
+
+    /// A cap on the surge (the way kept off while giving way): the ship under way at
+    /// 0.05 m/s with her reference 10 m ahead gathers way without it; with the cap at her
+    /// own speed no predicted surge exceeds it (to the slack the exact penalty leaves).
+    #[test]
+    fn a_surge_cap_keeps_the_plan_from_gathering_way() {
+        let fastest = |max_surge: Option<f64>| {
+            let mut mpc = ship_mpc_with(ShipMpcParams::default());
+            let mut data = data_at_rest(&mpc, [10.0, 0.0, 0.0], 0.0);
+            data.state[3] = 0.05;
+            data.max_surge = max_surge;
+            for _ in 0..40 {
+                assert!(mpc.step(&data).qp.is_usable());
+            }
+            mpc.predicted()
+                .iter()
+                .map(|x| x[3])
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
+        let (with, without) = (fastest(Some(0.05)), fastest(None));
+        assert!(with < 0.05 + 1e-3, "{with} m/s with the cap");
+        assert!(without > 0.05 + 5e-3, "{without} m/s without it");
+        let limits = MotionLimits::default();
+        assert_eq!(limits.capped(None), limits);
+        assert_eq!(limits.capped(Some(1.0)), limits);
+        assert_eq!(limits.capped(Some(0.04)).max_speed, 0.04);
     }
 
     /// The ship at the edge of its lane (its clearance from the bank just the margin) and a

@@ -66,6 +66,7 @@ fn paper_input(obstacles: &[Obstacle]) -> SampleInput<'_> {
         obstacles,
         distance_cost_off: 0,
         heading_floor: None,
+        max_surge: None,
         waterway: None,
     }
 }
@@ -155,6 +156,7 @@ fn plant_like_next<'a>(a: &Admm, input: &SampleInput<'a>, r: &AdmmReport) -> Sam
         obstacles: input.obstacles,
         distance_cost_off: input.distance_cost_off,
         heading_floor: None,
+        max_surge: None,
         waterway: None,
     }
 }

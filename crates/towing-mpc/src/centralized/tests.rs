@@ -49,6 +49,7 @@ fn instance(ahead: f64, lateral: f64, turn: f64, d: f64) -> SampleInput<'static>
         obstacles: &[],
         distance_cost_off: 0,
         heading_floor: None,
+        max_surge: None,
         waterway: None,
     }
 }
