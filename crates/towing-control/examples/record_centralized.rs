@@ -460,6 +460,17 @@ fn floats<const N: usize>(v: &Value, what: &str) -> Res<[f64; N]> {
     Ok(out)
 }
 
+/// A number or `null` (`None`) at `v`.
+fn optional_float(v: &Value, what: &str) -> Res<Option<f64>> {
+    match v {
+        Value::Null => Ok(None),
+        x => Ok(Some(
+            x.as_f64()
+                .ok_or_else(|| format!("{what}: {x} is not a number"))?,
+        )),
+    }
+}
+
 /// `[[f64; N]; M]` at `v`.
 fn nested<const M: usize, const N: usize>(v: &Value, what: &str) -> Res<[[f64; N]; M]> {
     let a = v
@@ -486,20 +497,6 @@ fn input_from(v: &Value, k: usize) -> Res<MpcInput> {
                 .map_err(|e| format!("{what}.obstacles[{j}]: {e}").into())
         })
         .collect::<Res<Vec<_>>>()?;
-    let heading_floor = match &v["heading_floor"] {
-        Value::Null => None,
-        x => Some(
-            x.as_f64()
-                .ok_or_else(|| format!("{what}.heading_floor: not a number"))?,
-        ),
-    };
-    let max_surge = match &v["max_surge"] {
-        Value::Null => None,
-        x => Some(
-            x.as_f64()
-                .ok_or_else(|| format!("{what}.max_surge: not a number"))?,
-        ),
-    };
     let input = SampleInput {
         ship: floats(&v["ship"], &format!("{what}.ship"))?,
         tugs: nested(&v["tugs"], &format!("{what}.tugs"))?,
@@ -512,8 +509,8 @@ fn input_from(v: &Value, k: usize) -> Res<MpcInput> {
         distance_cost_off: v["distance_cost_off"]
             .as_u64()
             .ok_or_else(|| format!("{what}.distance_cost_off: not an unsigned integer"))?,
-        heading_floor,
-        max_surge,
+        heading_floor: optional_float(&v["heading_floor"], &format!("{what}.heading_floor"))?,
+        max_surge: optional_float(&v["max_surge"], &format!("{what}.max_surge"))?,
         waterway: None,
     };
     Ok(MpcInput::of(&input))
