@@ -180,6 +180,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(v) = env("W_R") {
         config.tuning.ship.weight_yaw_rate = v;
     }
+    if let Some(v) = env("R17_TCPA") {
+        config.tuning.guidance.colregs.rule17.tcpa = v;
+    }
+    if let Some(v) = env("R17_WO") {
+        config.tuning.guidance.colregs.rule17.way_off_speed = v;
+    }
+    if let Some(v) = env("R17_DEC") {
+        config.tuning.guidance.colregs.rule17.way_off_deceleration = v;
+    }
+    if let Some(v) = env("R17_DCPA") {
+        config.tuning.guidance.colregs.rule17.dcpa = v;
+    }
     if let Some(v) = env("ARCH") {
         config.tuning.architecture = towing_control::Architecture::from_code(v as i32)?;
     }
@@ -309,8 +321,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             if std::env::var("GOV").is_ok() {
                 if let Some(g) = r.guidance.governing {
-                    eprintln!("GOV t {:.1} alt {} idx {} range {:.2} d9 {:.2} sit {:?} act {:?} det {} pc {} crossed {} man {:?} beta {:?}",
-                        world.time(), r.guidance.altered, g.index, g.range, g.distance_eq9, g.situation, g.action, g.detected, g.past_and_clear, g.crossed, g.manoeuvre,
+                    eprintln!("GOV t {:.1} alt {} wo {} u {:.3} idx {} range {:.2} d9 {:.2} sit {:?} act {:?} det {} pc {} crossed {} man {:?} beta {:?}",
+                        world.time(), r.guidance.altered, r.guidance.way_off, m.ship[3], g.index, g.range, g.distance_eq9, g.situation, g.action, g.detected, g.past_and_clear, g.crossed, g.manoeuvre,
                         g.encounter.map(|e| (e.bearing.to_degrees() * 10.0).round() / 10.0));
                 }
             }

@@ -672,10 +672,20 @@ impl Controller {
         // the tracked point lies abeam or ahead and drew her ahead again before
         // the target was past; a sudden cap at cruise speed made her crab (drift
         // 37-55 deg) as she slowed and turned.
-        let max_surge = (giving_way && t.tracking.give_way_way_off).then(|| {
-            let slowing = m.ship[3] - t.tracking.give_way_deceleration * t.prediction.sample_time;
-            t.tracking.give_way_surge.max(slowing)
+        // Rule 17(a)(ii), (b) with 8(e): a stand-on tow that must act and can let the
+        // target pass ahead takes the way off the same way, down to `way_off_speed`.
+        let slowing = m.ship[3] - t.tracking.give_way_deceleration * t.prediction.sample_time;
+        let give_way_cap = (giving_way && t.tracking.give_way_way_off)
+            .then(|| t.tracking.give_way_surge.max(slowing));
+        let rule17 = &t.guidance.colregs.rule17;
+        let rule17_cap = (guidance.way_off && t.scheme.alters()).then(|| {
+            let slowing = m.ship[3] - rule17.way_off_deceleration * t.prediction.sample_time;
+            rule17.way_off_speed.max(slowing)
         });
+        let max_surge = match (give_way_cap, rule17_cap) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
         let heading_floor = self.heading_floor(m.ship[2]);
         let reference = self.reference(
             &m.ship,

@@ -850,7 +850,7 @@ pub static PARAMETERS: &[Parameter] = &[
     Parameter {
         name: "guidance.rule17_tcpa",
         old_name: None,
-        description: "Rule 17(a)(ii): a stand-on tow acts once the TCPA of a target still closing to under guidance.rule17_dcpa is at most this; 30 s (docs/assumptions.md)",
+        description: "Rule 17(a)(ii): a stand-on tow acts once the TCPA of a target still closing to under guidance.rule17_dcpa is at most this, wherever the target is (not only within the detection distance); 55 s, 5 s inside the analyzer's 60 s (docs/assumptions.md)",
         kind: Kind::Real {
             unit: "s",
             min: Limit::Above(0.0),
@@ -869,6 +869,42 @@ pub static PARAMETERS: &[Parameter] = &[
             max: Limit::None,
             get: |t| t.guidance.colregs.rule17.dcpa,
             set: |t, v| t.guidance.colregs.rule17.dcpa = v,
+        },
+    },
+    Parameter {
+        name: "guidance.rule17_way_off_speed",
+        old_name: None,
+        description: "Rule 17(a)(ii), (b) with 8(e): when the stand-on tow must act and the target's track clears the tow going on at this speed, she keeps the route and takes the way off (at guidance.rule17_way_off_deceleration) down to this surge until the target is finally past and clear, else she alters to starboard; 0.01 m/s, the slowest at which she still held her head (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "m/s",
+            min: Limit::Above(0.0),
+            max: Limit::None,
+            get: |t| t.guidance.colregs.rule17.way_off_speed,
+            set: |t, v| t.guidance.colregs.rule17.way_off_speed = v,
+        },
+    },
+    Parameter {
+        name: "guidance.rule17_way_off_deceleration",
+        old_name: None,
+        description: "The deceleration at which the stand-on tow takes the way off under Rule 17 (guidance.rule17_way_off_speed): each sample the ship's plan keeps its surge at or below the measured surge less this times the sample time; the guidance counts the headway she carries meanwhile; 0.01 m/s^2, cruise to 0.01 m/s in about 10 s (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "m/s2",
+            min: Limit::Above(0.0),
+            max: Limit::None,
+            get: |t| t.guidance.colregs.rule17.way_off_deceleration,
+            set: |t, v| t.guidance.colregs.rule17.way_off_deceleration = v,
+        },
+    },
+    Parameter {
+        name: "guidance.rule17_close_quarters_tcpa",
+        old_name: None,
+        description: "Rule 17(b), close quarters: a target the tow stands on without acting (being overtaken) enters the MPC's distance cost once its TCPA is at most this and its DCPA under guidance.rule17_dcpa; 30 s (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "s",
+            min: Limit::Above(0.0),
+            max: Limit::None,
+            get: |t| t.guidance.colregs.rule17.close_quarters_tcpa,
+            set: |t, v| t.guidance.colregs.rule17.close_quarters_tcpa = v,
         },
     },
 ];

@@ -449,6 +449,54 @@ fn giving_way_in_a_crossing_the_plan_does_not_gather_way() {
     }
 }
 
+/// Rule 17(a)(ii), (b) with 8(e): a give-way target from port on a collision course,
+/// 9 m off on the port side (beyond d_D) and 54 s from the CPA: the stand-on tow keeps
+/// the route and takes the way off, the plan's surge capped at the measured surge less
+/// `guidance.rule17_way_off_deceleration` T_s, and at `guidance.rule17_way_off_speed`
+/// once she is slower. Scheme III (no COLREGS logic) has no cap.
+#[test]
+fn a_stand_on_tow_takes_the_way_off_under_rule_17() {
+    let (scenario, mut m) = paper_measurement();
+    let psi = m.ship[2];
+    m.ship[3] = 0.1;
+    m.ship[4] = 0.0;
+    let (fwd, stb) = (5.4, -9.0);
+    m.obstacles[3] = ObstacleSlot {
+        x: m.ship[0] + fwd * psi.cos() - stb * psi.sin(),
+        y: m.ship[1] + fwd * psi.sin() + stb * psi.cos(),
+        psi: psi + std::f64::consts::FRAC_PI_2,
+        speed: 9.0 / 54.0,
+        length: 1.48,
+        width: 0.48,
+        kind: ObstacleKind::VesselEllipse,
+    };
+    let config = ControllerConfig::new(scenario.clone());
+    let rule17 = config.tuning.guidance.colregs.rule17;
+    let slowing = rule17.way_off_deceleration * config.tuning.prediction.sample_time;
+    let mut c = Controller::new(config.clone()).unwrap();
+    for (u, expected) in [(0.1, 0.1 - slowing), (0.005, rule17.way_off_speed)] {
+        m.ship[3] = u;
+        let r = c.sample(&m).unwrap();
+        assert_eq!(r.situation[3], Some(Situation::CrossingStandOn));
+        assert!(
+            r.guidance.way_off && !r.guidance.altered,
+            "{:?}",
+            r.guidance
+        );
+        let got = c.last_mpc_input().unwrap().max_surge.expect("a cap");
+        assert!(
+            (got - expected).abs() < 1e-12,
+            "surge {u}: cap {got}, expected {expected}"
+        );
+    }
+    let mut config = config;
+    config.tuning.scheme = AvoidanceScheme::CostOnly;
+    let mut c = Controller::new(config).unwrap();
+    m.ship[3] = 0.1;
+    c.sample(&m).unwrap();
+    assert_eq!(c.last_mpc_input().unwrap().max_surge, None);
+}
+
 #[test]
 fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
     let (scenario, mut m) = paper_measurement();

@@ -447,9 +447,10 @@ pub enum Action {
     /// eq. (13), stays the last resort).
     StandOn,
     /// Rule 17(a)(i) then (a)(ii)/(b): keep course and speed until the give-way
-    /// vessel fails to act in time ([`Rule17Settings`]), then alter to starboard
-    /// (Rule 17(c): never to port for a vessel on own port side). Also the policy
-    /// for [`Situation::Unclassified`]: act to starboard once the CPA is short.
+    /// vessel fails to act in time ([`Rule17Settings`]), then take the way off or
+    /// alter to starboard (the reference system chooses, [`Manoeuvre::TakeWayOff`];
+    /// Rule 17(c): never to port for a vessel on own port side). Also the policy for
+    /// [`Situation::Unclassified`]: act once the CPA is short.
     StandOnThenAct,
 }
 
@@ -474,11 +475,11 @@ pub fn action(situation: Situation, status: TowStatus) -> Action {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Rule17Settings {
     /// TCPA (s) at or below which the stand-on tow acts if the DCPA is still
-    /// short. Assumption (the paper has none; its stand-on role simply ends at
-    /// `d_D`): 30 s, ten MPC horizons (`H_P T_s = 3 s`, Table 3) and about half
-    /// the TCPA at which a crossing target of the paper (0.07 m/s across a tow at
-    /// about 0.1 m/s) enters the default `d_D` of 7 m (about 60 s): the give-way
-    /// vessel gets the first half to act, the slow tow keeps the second to turn.
+    /// short, wherever the target is (Rule 17(a)(ii): "as soon as it becomes
+    /// apparent"). Assumption (the paper has none; its stand-on role simply ends at
+    /// `d_D`): 55 s, 5 s inside the 60 s before which the analyzer holds the tow to
+    /// its course and speed; a 5.5 m long tow at 0.1 m/s needs about that long to let
+    /// a target aimed at its middle pass (`docs/colregs.md`, "Rule 17, in time").
     pub tcpa: f64,
     /// DCPA (m, ship centre to target centre) below which the give-way vessel is
     /// deemed not to have acted. Assumption: 2.5 m, about two ship lengths, just
@@ -486,13 +487,34 @@ pub struct Rule17Settings {
     /// targets (`L + a + d_S0 = 1.255 + 0.74 + 0.25 = 2.245 m` in range units): a
     /// give-way vessel that has acted opens the CPA beyond the safe distance.
     pub dcpa: f64,
+    /// Speed (m/s) the tow keeps when it takes the way off under Rule 17
+    /// ([`Manoeuvre::TakeWayOff`]): the surge the ship's plan is held to, and the speed
+    /// along the ship's heading at which the guidance predicts the tow's track against
+    /// the target's. Assumption: 0.01 m/s, the slowest speed at which the MPC still
+    /// held the stopped tow's head in the runs examined (`docs/assumptions.md`).
+    pub way_off_speed: f64,
+    /// Deceleration (m/s^2) at which the tow takes the way off under Rule 17: the
+    /// controller lowers the surge cap of the ship's plan by this much per second, and
+    /// the guidance counts the headway the tow carries while slowing,
+    /// `(u^2 - way_off_speed^2) / (2 a)`. Assumption: 0.01 m/s^2, cruise to 0.01 m/s
+    /// in about 10 s with 0.5 m of headway (`docs/assumptions.md`).
+    pub way_off_deceleration: f64,
+    /// Close quarters (Rule 17(b)): TCPA (s) at or below which, with the DCPA under
+    /// [`Self::dcpa`], a target the tow stands on without ever acting on it (being
+    /// overtaken, [`Action::StandOn`]) enters the MPC's distance cost, the last resort.
+    /// Assumption: 30 s, ten MPC horizons (the Rule 17 action point of the earlier
+    /// versions).
+    pub close_quarters_tcpa: f64,
 }
 
 impl Default for Rule17Settings {
     fn default() -> Self {
         Self {
-            tcpa: 30.0,
+            tcpa: 55.0,
             dcpa: 2.5,
+            way_off_speed: 0.01,
+            way_off_deceleration: 0.01,
+            close_quarters_tcpa: 30.0,
         }
     }
 }
@@ -504,6 +526,13 @@ impl Rule17Settings {
     pub fn give_way_failed(&self, cpa: &Cpa) -> bool {
         cpa.is_closing() && cpa.tcpa <= self.tcpa && cpa.dcpa < self.dcpa
     }
+
+    /// True at close quarters (Rule 17(b)): closing, `TCPA <= close_quarters_tcpa` and
+    /// `DCPA < dcpa`.
+    #[must_use]
+    pub fn at_close_quarters(&self, cpa: &Cpa) -> bool {
+        cpa.is_closing() && cpa.tcpa <= self.close_quarters_tcpa && cpa.dcpa < self.dcpa
+    }
 }
 
 /// What the reference system does now for one obstacle.
@@ -513,6 +542,12 @@ pub enum Manoeuvre {
     FollowRoute,
     /// Alter the active waypoint to starboard (eq. (10)-(11)).
     AlterToStarboard,
+    /// Rule 17(a)(ii), (b) with Rule 8(e): a stand-on tow that must act keeps the
+    /// route and takes the way off, so that the give-way target passes ahead. Chosen
+    /// over the starboard alteration when the target's track clears the tow held at
+    /// [`Rule17Settings::way_off_speed`] (see `docs/colregs.md`, "Rule 17: which
+    /// action").
+    TakeWayOff,
 }
 
 impl Action {
@@ -563,6 +598,15 @@ impl ColregsSettings {
         };
         positive("rule17.tcpa", self.rule17.tcpa)?;
         positive("rule17.dcpa", self.rule17.dcpa)?;
+        positive("rule17.way_off_speed", self.rule17.way_off_speed)?;
+        positive(
+            "rule17.way_off_deceleration",
+            self.rule17.way_off_deceleration,
+        )?;
+        positive(
+            "rule17.close_quarters_tcpa",
+            self.rule17.close_quarters_tcpa,
+        )?;
         if let Some(d) = self.risk_dcpa {
             positive("risk_dcpa", d)?;
         }
@@ -857,10 +901,11 @@ mod tests {
     fn rule17_threshold() {
         let r = Rule17Settings::default();
         let m = |tcpa, dcpa| Action::StandOnThenAct.manoeuvre(&Cpa { tcpa, dcpa }, &r);
-        assert_eq!(m(30.1, 0.0), Manoeuvre::FollowRoute);
-        assert_eq!(m(29.9, 0.0), Manoeuvre::AlterToStarboard);
-        assert_eq!(m(29.9, 2.49), Manoeuvre::AlterToStarboard);
-        assert_eq!(m(29.9, 2.51), Manoeuvre::FollowRoute);
+        let (t, d) = (r.tcpa, r.dcpa);
+        assert_eq!(m(t + 0.1, 0.0), Manoeuvre::FollowRoute);
+        assert_eq!(m(t - 0.1, 0.0), Manoeuvre::AlterToStarboard);
+        assert_eq!(m(t - 0.1, d - 0.01), Manoeuvre::AlterToStarboard);
+        assert_eq!(m(t - 0.1, d + 0.01), Manoeuvre::FollowRoute);
         assert_eq!(m(-1.0, 0.0), Manoeuvre::FollowRoute);
         assert_eq!(
             Action::StandOn.manoeuvre(

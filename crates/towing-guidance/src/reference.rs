@@ -18,9 +18,12 @@
 //!    than the route does ([`StaticHazardPolicy::WhenAlteringHelps`], the default;
 //!    [`StaticHazardPolicy::ByDistance`] drops that test), a target ship if its
 //!    action is
-//!    [`Action::AlterToStarboard`] or [`Action::KeepOut`], or
-//!    [`Action::StandOnThenAct`] once Rule 17 allows action
-//!    ([`crate::Rule17Settings`]). A stand-on tow keeps the route until then.
+//!    [`Action::AlterToStarboard`] or [`Action::KeepOut`]. A stand-on tow keeps the
+//!    route until Rule 17 allows action ([`Action::StandOnThenAct`],
+//!    [`crate::Rule17Settings`]), judged by the CPA wherever the target is; it then
+//!    takes the way off ([`Manoeuvre::TakeWayOff`], route kept) if the slowed tow lets
+//!    the target pass clear ahead, else it demands the alteration. A way-off is held
+//!    like an alteration (step 3) and reported in [`GuidanceOutput::way_off`].
 //! 3. An obstacle that demanded the alteration keeps it until its distance exceeds
 //!    its detection distance plus `release_margin` (for a static hazard: or the
 //!    alteration no longer helps, on a new segment) (the encounter is over; Rule
@@ -29,8 +32,8 @@
 //!    that distance, once it is past and clear ([`past_and_clear`]: the range from
 //!    every vessel of the tow opening and beyond that vessel's eq. (14) safe range
 //!    plus `release_margin`). Such an encounter stays over until the target leaves
-//!    the encounter distance, unless it closes again into a close-quarters situation
-//!    (Rule 17's TCPA and DCPA limits).
+//!    the encounter distance, unless it closes again into a situation in which Rule 17
+//!    would act (its TCPA and DCPA limits).
 //! 4. While any obstacle keeps it, the reference is the active waypoint rotated to
 //!    starboard about the previous predefined waypoint (eq. (10)-(11)); otherwise the
 //!    predefined waypoint (eq. (8), `eta_Sd = eta_Sp`).
@@ -42,9 +45,9 @@ use serde::{Deserialize, Serialize};
 use towing_model::{ObstacleKind, ObstacleSlot, Pose, MAX_OBSTACLES};
 
 use crate::colregs::{action, classify, safe_reading, Action, Encounter, Manoeuvre, Situation};
-use crate::distance::ActiveObstacle;
+use crate::distance::{ActiveObstacle, Ellipse};
 use crate::error::InputError;
-use crate::geometry::{dist, segment_distance};
+use crate::geometry::{cpa, dist, segment_distance};
 use crate::params::{GuidanceParams, StaticHazardPolicy};
 use crate::waypoint::{rotate_waypoint, theta_max, Route};
 
@@ -140,6 +143,10 @@ pub struct ObstacleAssessment {
     /// What it asks of the reference system now (detection, Rule 17 and
     /// `past_and_clear` applied).
     pub manoeuvre: Manoeuvre,
+    /// With the way off for this target ([`AssessContext::resume_speed`]): the tow
+    /// resuming at that speed along her heading would pass it clear of every vessel
+    /// ([`clearance_margin`] at least 0). True otherwise.
+    pub resume_clear: bool,
 }
 
 /// What the reference system knows beyond the obstacle and the tow.
@@ -162,6 +169,13 @@ pub struct AssessContext {
     /// This target has crossed the ship's heading line ahead of her by its own motion
     /// since its encounter began (ignored for static hazards).
     pub crossed: bool,
+    /// The tow has taken the way off for this target under Rule 17
+    /// ([`Manoeuvre::TakeWayOff`]) and keeps it off: an action once taken is held,
+    /// not changed into an alteration (Rule 8(a), (d)).
+    pub way_off: bool,
+    /// With the way off for this target: the ship's speed along her heading when she
+    /// took it off, at which the release predicts her resumed track.
+    pub resume_speed: Option<f64>,
 }
 
 /// The ship's pose and a target's position at one sample: the next sample tells from
@@ -264,13 +278,39 @@ pub fn assess_obstacle(
                 (situation, crossed, enc.bearing),
             )
     });
+    // Rule 17 is judged by the CPA, not by d_D: a stand-on tow acts once the give-way
+    // vessel has failed to act in time, wherever the target is then.
+    let rule17 = &s.colregs.rule17;
+    let rule17_acts = policy == Action::StandOnThenAct
+        && encounter.is_some_and(|enc| rule17.give_way_failed(&enc.cpa));
     let manoeuvre = match (
-        detected && alteration_allowed && !past_and_clear,
+        (detected || rule17_acts) && alteration_allowed && !past_and_clear,
         &encounter,
     ) {
         (false, _) => Manoeuvre::FollowRoute,
         (true, None) => Manoeuvre::AlterToStarboard,
-        (true, Some(enc)) => policy.manoeuvre(&enc.cpa, &s.colregs.rule17),
+        (true, Some(enc)) => match policy.manoeuvre(&enc.cpa, rule17) {
+            Manoeuvre::AlterToStarboard
+                if rule17_acts
+                    && (context.way_off || way_off_chosen(params, tow, &vessels, obstacle)) =>
+            {
+                Manoeuvre::TakeWayOff
+            }
+            m => m,
+        },
+    };
+    let resume_clear = match (obstacle, context.resume_speed) {
+        (ActiveObstacle::Vessel(target), Some(speed)) => {
+            let (sin, cos) = tow.ship.psi.sin_cos();
+            clearance_margin(
+                params,
+                &vessels,
+                target,
+                [0.0; 2],
+                [speed * cos, speed * sin],
+            ) >= 0.0
+        }
+        _ => true,
     };
     ObstacleAssessment {
         index,
@@ -287,6 +327,7 @@ pub fn assess_obstacle(
         past_and_clear,
         crossed,
         manoeuvre,
+        resume_clear,
     }
 }
 
@@ -338,13 +379,88 @@ fn past_and_clear(
     })
 }
 
+/// Whether Rule 17's action for `obstacle`, a target ship, is to take the way off
+/// rather than to alter to starboard (false for a static hazard): the target keeps its
+/// course and speed, and the tow (the tugs with the ship, as in [`past_and_clear`])
+/// either goes on along the ship's heading at [`crate::Rule17Settings::way_off_speed`]
+/// after the headway it carries while slowing at
+/// [`crate::Rule17Settings::way_off_deceleration`], or keeps its present velocity.
+/// The way-off is taken when it passes the target clear of every vessel of the tow
+/// (range-equivalent distance at the closest approach above that vessel's eq. (14) safe
+/// range, [`clearance_margin`]) or at least farther than keeping on would. Taking the way
+/// off helps a target that crosses ahead of the slowed tow; one whose track runs over it
+/// (head-on, or crossing at the tow's own position) gets the starboard alteration.
+fn way_off_chosen(
+    params: &GuidanceParams,
+    tow: &TowState,
+    vessels: &[(TowVessel, [f64; 2], f64); 3],
+    obstacle: &ActiveObstacle,
+) -> bool {
+    let ActiveObstacle::Vessel(target) = obstacle else {
+        return false;
+    };
+    let rule17 = &params.settings().colregs.rule17;
+    let (sin, cos) = tow.ship.psi.sin_cos();
+    let speed = rule17.way_off_speed;
+    // The headway carried while slowing from the present speed along the heading,
+    // taken at once (the tow ahead of where it will be: the safe side for a target
+    // crossing ahead of it).
+    let u = tow.ship_vel_n[0] * cos + tow.ship_vel_n[1] * sin;
+    let headway = (u * u - speed * speed).max(0.0) / (2.0 * rule17.way_off_deceleration);
+    let slowed = clearance_margin(
+        params,
+        vessels,
+        target,
+        [headway * cos, headway * sin],
+        [speed * cos, speed * sin],
+    );
+    slowed > 0.0 || slowed > clearance_margin(params, vessels, target, [0.0; 2], tow.ship_vel_n)
+}
+
+/// The smallest margin (m) over the vessels of the tow between the range-equivalent
+/// distance of `target` at its closest approach (centre to centre, [`cpa`]) and that
+/// vessel's eq. (14) safe range, for a tow moving at `v_own` from its vessels' positions
+/// shifted by `offset`, the target keeping its course and speed.
+fn clearance_margin(
+    params: &GuidanceParams,
+    vessels: &[(TowVessel, [f64; 2], f64); 3],
+    target: &Ellipse,
+    offset: [f64; 2],
+    v_own: [f64; 2],
+) -> f64 {
+    let buffer = params.settings().safety_buffer;
+    let v_target = target.velocity();
+    let dv = [v_target[0] - v_own[0], v_target[1] - v_own[1]];
+    vessels
+        .iter()
+        .map(|&(_, p, length)| {
+            let p = [p[0] + offset[0], p[1] + offset[1]];
+            let c = cpa(p, v_own, target.centre, v_target);
+            let t = if c.tcpa.is_finite() {
+                c.tcpa.max(0.0)
+            } else {
+                0.0
+            };
+            let at_cpa = ActiveObstacle::Vessel(Ellipse {
+                centre: [target.centre[0] + dv[0] * t, target.centre[1] + dv[1] * t],
+                ..*target
+            });
+            at_cpa.range(p) - at_cpa.safe_range(length, buffer)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// The tow stands on for this assessment's target (see [`ReferenceSystem::stands_on`]).
 fn stands_on(params: &GuidanceParams, a: &ObstacleAssessment) -> bool {
     let rule17 = &params.settings().colregs.rule17;
+    let acts = |cpa: &crate::Cpa| match a.action {
+        Action::StandOn => rule17.at_close_quarters(cpa),
+        _ => rule17.give_way_failed(cpa),
+    };
     matches!(a.action, Action::StandOn | Action::StandOnThenAct)
         && a.manoeuvre == Manoeuvre::FollowRoute
         && !a.past_and_clear
-        && a.encounter.is_some_and(|e| !rule17.give_way_failed(&e.cpa))
+        && a.encounter.is_some_and(|e| !acts(&e.cpa))
 }
 
 /// Output of one sample.
@@ -359,6 +475,9 @@ pub struct GuidanceOutput {
     pub active_waypoint: usize,
     /// True when `eta_Sd` is the altered waypoint `eta_Sn` (eq. (10)-(11)).
     pub altered: bool,
+    /// True while the tow keeps the way off for a target under Rule 17
+    /// ([`Manoeuvre::TakeWayOff`]); the route itself is kept unless `altered`.
+    pub way_off: bool,
     /// Altering angle applied (rad): `min(theta, theta_max)` when altered, else 0.
     pub theta: f64,
     /// `d_ob` (m): smallest range-equivalent distance between the tow and any
@@ -404,17 +523,52 @@ pub struct ReferenceSystem {
     #[serde(skip)]
     params: GuidanceParams,
     active: usize,
+    encounters: Encounters,
+}
+
+/// What the reference system remembers of the encounters between samples, per obstacle
+/// slot (bit `k` of a mask, element `k` of an array); [`ReferenceSystem::update`] builds
+/// the next sample's from the last.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Encounters {
+    /// Keeping the route altered.
     latched: u64,
+    /// A target for which the tow has taken the way off (Rule 17).
+    way_off: u64,
+    /// With the way off: the ship's speed along her heading when she took it off.
+    resume_speed: [f64; MAX_OBSTACLES],
+    /// Found past and clear, the encounter not yet over.
     cleared: u64,
+    /// Crossed the ship's heading line ahead of her by its own motion.
     crossed: u64,
-    /// Per slot: past and clear at the last sample.
+    /// Past and clear at the last sample.
     past: u64,
-    /// Per slot: a target the tow stands on at the last sample, Rule 17 not yet
-    /// allowing action.
+    /// Left out of the MPC's distance cost: the tow stands on for it (Rule 17 not yet
+    /// allowing action), has taken the way off for it, or it is over.
     standing_on: u64,
+    /// The situation held for the encounter.
     held: [Option<Situation>; MAX_OBSTACLES],
+    /// The situation at the last sample (held or present).
     situations: [Option<Situation>; MAX_OBSTACLES],
+    /// Where the ship and the target were at the last sample.
     sightings: [Option<Sighting>; MAX_OBSTACLES],
+}
+
+impl Encounters {
+    fn new() -> Self {
+        Self {
+            latched: 0,
+            way_off: 0,
+            resume_speed: [0.0; MAX_OBSTACLES],
+            cleared: 0,
+            crossed: 0,
+            past: 0,
+            standing_on: 0,
+            held: [None; MAX_OBSTACLES],
+            situations: [None; MAX_OBSTACLES],
+            sightings: [None; MAX_OBSTACLES],
+        }
+    }
 }
 
 impl ReferenceSystem {
@@ -425,14 +579,7 @@ impl ReferenceSystem {
             route,
             params,
             active: 1,
-            latched: 0,
-            cleared: 0,
-            crossed: 0,
-            past: 0,
-            standing_on: 0,
-            held: [None; MAX_OBSTACLES],
-            situations: [None; MAX_OBSTACLES],
-            sightings: [None; MAX_OBSTACLES],
+            encounters: Encounters::new(),
         }
     }
 
@@ -461,14 +608,7 @@ impl ReferenceSystem {
     /// Back to the start of the route, no encounter.
     pub fn reset(&mut self) {
         self.active = 1;
-        self.latched = 0;
-        self.cleared = 0;
-        self.crossed = 0;
-        self.past = 0;
-        self.standing_on = 0;
-        self.held = [None; MAX_OBSTACLES];
-        self.situations = [None; MAX_OBSTACLES];
-        self.sightings = [None; MAX_OBSTACLES];
+        self.encounters = Encounters::new();
     }
 
     /// The route.
@@ -495,30 +635,33 @@ impl ReferenceSystem {
     /// slots and slots beyond those given.
     #[must_use]
     pub fn situation(&self, slot: usize) -> Option<Situation> {
-        self.situations.get(slot).copied().flatten()
+        self.encounters.situations.get(slot).copied().flatten()
     }
 
     /// True when the target ship in slot `slot` was past and clear at the last
     /// [`update`](Self::update) ([`ObstacleAssessment::past_and_clear`]).
     #[must_use]
     pub fn past_and_clear(&self, slot: usize) -> bool {
-        slot < MAX_OBSTACLES && self.past & (1 << slot) != 0
+        slot < MAX_OBSTACLES && self.encounters.past & (1 << slot) != 0
     }
 
     /// True when the tow stands on for the target ship in slot `slot` at the last
     /// [`update`](Self::update): its policy is to keep course and speed
-    /// ([`Action::StandOn`], [`Action::StandOnThenAct`]), it is neither past and
-    /// clear nor at close quarters (Rule 17(a)(ii), (b): the TCPA and DCPA limits of
-    /// [`crate::Rule17Settings`]), and the route is kept for it.
+    /// ([`Action::StandOn`], [`Action::StandOnThenAct`]), it is not past and clear,
+    /// Rule 17 does not yet let the tow act (for [`Action::StandOnThenAct`] its action
+    /// point, for [`Action::StandOn`] close quarters:
+    /// [`crate::Rule17Settings::close_quarters_tcpa`]), and the route is kept for it;
+    /// or the tow has taken the way off for it (its action; the MPC's distance cost
+    /// leaves it out, its clearance rows stay).
     #[must_use]
     pub fn stands_on(&self, slot: usize) -> bool {
-        slot < MAX_OBSTACLES && self.standing_on & (1 << slot) != 0
+        slot < MAX_OBSTACLES && self.encounters.standing_on & (1 << slot) != 0
     }
 
     /// True while an encounter keeps the route altered.
     #[must_use]
     pub fn is_altered(&self) -> bool {
-        self.latched != 0
+        self.encounters.latched != 0
     }
 
     /// Altering angle of segment `p`: `theta`, bounded by `theta_max` (remark on
@@ -559,6 +702,87 @@ impl ReferenceSystem {
         along >= r
     }
 
+    /// Steps 2 and 3 of the module doc for one assessed obstacle: what the next sample
+    /// remembers of its encounter (held situation, sighting, past and clear, the
+    /// alteration and way-off latches, standing on), written into `next`; true when it
+    /// keeps the route altered.
+    fn track(
+        &self,
+        next: &mut Encounters,
+        a: &ObstacleAssessment,
+        context: &AssessContext,
+        (sighting, tow): (Sighting, &TowState),
+    ) -> bool {
+        let s = self.params.settings();
+        let bit = 1u64 << a.index;
+        next.situations[a.index] = a.situation;
+        let detection = match a.kind {
+            ObstacleKind::StaticCircle => s.static_detection_distance,
+            _ => s.detection_distance,
+        };
+        let near = a.range <= detection + s.release_margin;
+        let slowed = context.way_off;
+        if a.past_and_clear {
+            next.past |= bit;
+        }
+        // Rule 8(d): the way stays off until the target is past and clear (it has
+        // crossed ahead of the slowed tow by its own motion and the range is opening
+        // and safe from every vessel) and the tow resuming at her former speed would
+        // pass it clear (else she would turn away from it or run up on it), or until
+        // it has left the encounter distance and is no longer closing.
+        let closing = a.encounter.is_some_and(|e| e.cpa.is_closing());
+        let finally_clear = a.past_and_clear && a.resume_clear;
+        let keeps_way_off = slowed && !finally_clear && (near || closing);
+        if a.manoeuvre == Manoeuvre::TakeWayOff || keeps_way_off {
+            next.way_off |= bit;
+            next.resume_speed[a.index] = context.resume_speed.unwrap_or_else(|| {
+                let (sin, cos) = tow.ship.psi.sin_cos();
+                tow.ship_vel_n[0] * cos + tow.ship_vel_n[1] * sin
+            });
+        }
+        // A way-off taken under Rule 17 (judged by the CPA, possibly beyond d_D) keeps
+        // the encounter open, up to the sample that releases it.
+        let in_encounter = near || slowed || next.way_off & bit != 0;
+        // The way-off is the tow's action and lets the target pass ahead: the
+        // MPC's distance cost leaves the target out as for a stand-on target (its
+        // clearance rows stay), so the tugs do not swing the tow's head after it; so
+        // does a target she stood on once it is past and clear and her resumed track
+        // passes it clear: pushed off by the cost, the resuming tow turned 14 deg to
+        // port, away from a slow target that had crossed ahead (`docs/colregs.md`).
+        let stood_on = context
+            .held
+            .is_some_and(|h| matches!(h, Situation::CrossingStandOn | Situation::BeingOvertaken));
+        let over = stood_on && a.past_and_clear && a.resume_clear;
+        if in_encounter && (next.way_off & bit != 0 || over || stands_on(&self.params, a)) {
+            next.standing_on |= bit;
+        }
+        if let (true, Some(situation)) = (in_encounter, a.situation) {
+            let definite = situation != Situation::Safe;
+            let acting = a.detected || a.manoeuvre != Manoeuvre::FollowRoute;
+            next.held[a.index] = context.held.or((acting && definite).then_some(situation));
+            next.sightings[a.index] = Some(sighting);
+            if a.crossed {
+                next.crossed |= bit;
+            }
+        }
+        // An encounter found past and clear stays over until it ends (or a new
+        // close-quarters situation arises, in `assess_obstacle`): the tow's own
+        // return to the route must not turn an opening range into a new encounter.
+        let acted = (self.encounters.latched | self.encounters.way_off) & bit != 0;
+        if in_encounter && a.past_and_clear && (context.cleared || acted) {
+            next.cleared |= bit;
+        }
+        let demands = a.manoeuvre == Manoeuvre::AlterToStarboard;
+        let keeps = self.encounters.latched & bit != 0
+            && in_encounter
+            && a.alteration_allowed
+            && !a.past_and_clear;
+        if demands || keeps {
+            next.latched |= bit;
+        }
+        demands || keeps
+    }
+
     /// One sample: assess the obstacles (slot `k` of `obstacles` is obstacle `k`;
     /// [`ObstacleKind::None`] slots are ignored), update the encounter state and the active
     /// waypoint, and return the reference.
@@ -578,18 +802,10 @@ impl ReferenceSystem {
                 max: MAX_OBSTACLES,
             });
         }
-        let s = self.params.settings();
         let mut d_ob = f64::INFINITY;
         let mut nearest: Option<ObstacleAssessment> = None;
+        let mut next = Encounters::new();
         let mut nearest_latched: Option<ObstacleAssessment> = None;
-        let mut latched = 0u64;
-        let mut cleared = 0u64;
-        let mut crossed = 0u64;
-        let mut past = 0u64;
-        let mut standing_on = 0u64;
-        let mut held = [None; MAX_OBSTACLES];
-        let mut situations = [None; MAX_OBSTACLES];
-        let mut sightings = [None; MAX_OBSTACLES];
         let points = self.route.points();
         let leg = [
             points[self.active - 1].position(),
@@ -600,73 +816,37 @@ impl ReferenceSystem {
             let Some(obstacle) = ActiveObstacle::from_slot(input)? else {
                 continue;
             };
-            let held_before = match obstacle {
-                ActiveObstacle::Vessel(_) => self.held[index],
-                ActiveObstacle::Circle { .. } => None,
-            };
             let bit = 1u64 << index;
             let context = AssessContext {
-                held: held_before,
+                held: match obstacle {
+                    ActiveObstacle::Vessel(_) => self.encounters.held[index],
+                    ActiveObstacle::Circle { .. } => None,
+                },
                 leg: Some(leg),
-                cleared: self.cleared & bit != 0,
-                previous: self.sightings[index],
-                crossed: self.crossed & bit != 0,
+                cleared: self.encounters.cleared & bit != 0,
+                previous: self.encounters.sightings[index],
+                crossed: self.encounters.crossed & bit != 0,
+                way_off: self.encounters.way_off & bit != 0,
+                resume_speed: (self.encounters.way_off & bit != 0)
+                    .then_some(self.encounters.resume_speed[index]),
             };
             let a = assess_obstacle(&self.params, tow, index, &obstacle, &context);
-            situations[index] = a.situation;
             if a.range < d_ob {
                 d_ob = a.range;
                 nearest = Some(a);
             }
-            let detection = match a.kind {
-                ObstacleKind::StaticCircle => s.static_detection_distance,
-                _ => s.detection_distance,
+            let sighting = Sighting {
+                ship: tow.ship,
+                target: obstacle.centre(),
             };
-            let in_encounter = a.range <= detection + s.release_margin;
-            if a.past_and_clear {
-                past |= bit;
-            }
-            if in_encounter && stands_on(&self.params, &a) {
-                standing_on |= bit;
-            }
-            if let (true, Some(situation)) = (in_encounter, a.situation) {
-                let definite = situation != Situation::Safe;
-                held[index] = held_before.or((a.detected && definite).then_some(situation));
-                sightings[index] = Some(Sighting {
-                    ship: tow.ship,
-                    target: obstacle.centre(),
-                });
-                if a.crossed {
-                    crossed |= bit;
-                }
-            }
-            // An encounter found past and clear stays over until it ends (or a new
-            // close-quarters situation arises, in `assess_obstacle`): the tow's own
-            // return to the route must not turn an opening range into a new encounter.
-            if in_encounter && a.past_and_clear && (context.cleared || self.latched & bit != 0) {
-                cleared |= bit;
-            }
-            let demands = a.manoeuvre == Manoeuvre::AlterToStarboard;
-            let keeps = self.latched & bit != 0
-                && in_encounter
-                && a.alteration_allowed
-                && !a.past_and_clear;
-            if demands || keeps {
-                latched |= bit;
-                if nearest_latched.is_none_or(|n| a.range < n.range) {
-                    nearest_latched = Some(a);
-                }
+            let keeps_altered = self.track(&mut next, &a, &context, (sighting, tow));
+            if keeps_altered && nearest_latched.is_none_or(|n| a.range < n.range) {
+                nearest_latched = Some(a);
             }
         }
-        self.latched = latched;
-        self.cleared = cleared;
-        self.crossed = crossed;
-        self.past = past;
-        self.standing_on = standing_on;
-        self.held = held;
-        self.situations = situations;
-        self.sightings = sightings;
-        let altered = latched != 0;
+        let altered = next.latched != 0;
+        let way_off = next.way_off;
+        self.encounters = next;
 
         let ship = tow.ship.position();
         let last = self.route.last_index();
@@ -680,6 +860,7 @@ impl ReferenceSystem {
             route_waypoint: self.route.points()[self.active],
             active_waypoint: self.active,
             altered,
+            way_off: way_off != 0,
             theta,
             d_ob,
             governing: if altered { nearest_latched } else { nearest },
@@ -1005,42 +1186,98 @@ mod tests {
     /// Ship northbound at 0.1 m/s along the route, open loop; target from the port
     /// side heading East at 4/60 m/s, on a collision course with the ship at
     /// (6, 0) in 60 s.
-    #[test]
-    fn stand_on_crossing_from_port_waits_for_rule_17_then_alters_to_starboard() {
+    /// A give-way target from port on a collision course with the ship's centre: it
+    /// reaches `(cross_x, 0)` at `t_cross` s on `course_deg` at `speed`, as the ship
+    /// does at 0.1 m/s. The tow takes the way off as the guidance asks (at the Rule 17
+    /// deceleration, down to its way-off speed, and resumes 0.1 m/s once it is released).
+    /// Returns per second `(t, tcpa, altered, way_off, past_and_clear, out of the
+    /// distance cost)` while the encounter lasts.
+    fn stand_on_run(
+        seconds: u32,
+        (cross_x, t_cross): (f64, f64),
+        (course_deg, speed): (f64, f64),
+    ) -> Vec<(f64, f64, bool, bool, bool, bool)> {
         let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
-        let speed_t = 4.0 / 60.0;
-        let mut first_altered = None;
-        for t in 0..55 {
+        let rule17 = GuidanceSettings::default().colregs.rule17;
+        let (sin, cos) = deg(course_deg).sin_cos();
+        let start = [cross_x - speed * t_cross * cos, -speed * t_cross * sin];
+        let (mut x, mut u) = (0.0, 0.1);
+        let mut rows = Vec::new();
+        for t in 0..seconds {
             let t = f64::from(t);
-            let tow = tow_at(Pose::new(0.1 * t, 0.0, 0.0), 0.1);
-            let target = vessel(6.0, -4.0 + speed_t * t, deg(90.0), speed_t);
+            let tow = tow_at(Pose::new(x, 0.0, 0.0), u);
+            let target = moved(vessel(start[0], start[1], deg(course_deg), speed), t);
             let out = rs.update(&tow, &[target]).unwrap();
             let g = out.governing.unwrap();
-            let enc = g.encounter.unwrap();
-            assert_eq!(enc.situation, Situation::CrossingStandOn, "t = {t}");
-            assert_eq!(g.action, Action::StandOnThenAct);
-            // Detected from the start (tug 2 is 5.6 m away) ...
-            assert!(g.detected);
-            assert!((enc.cpa.tcpa - (60.0 - t)).abs() < 1e-9 && enc.cpa.dcpa < 1e-9);
-            if first_altered.is_none() {
-                // ... but the route is kept while TCPA > 30 s.
-                assert_eq!(out.altered, enc.cpa.tcpa <= 30.0, "t = {t}");
-                if out.altered {
-                    first_altered = Some(t);
-                }
-            } else {
-                // Once acted, the alteration holds (the target is still close).
-                assert!(out.altered);
+            if g.situation != Some(Situation::CrossingStandOn) {
+                assert!(t > t_cross, "t = {t}: {g:?}");
+                break;
             }
-            if out.altered {
-                // To starboard of the northbound route, never to port.
-                assert!(out.eta_sd.y > 0.0 && out.eta_sd.psi > 0.0);
+            let tcpa = g.encounter.unwrap().cpa.tcpa;
+            let off = rs.stands_on(0);
+            rows.push((t, tcpa, out.altered, out.way_off, g.past_and_clear, off));
+            u = if out.way_off {
+                (u - rule17.way_off_deceleration).max(rule17.way_off_speed)
             } else {
-                assert_eq!(out.eta_sd, Pose::new(30.0, 0.0, 0.0));
+                0.1
+            };
+            x += u;
+        }
+        rows
+    }
+
+    #[test]
+    fn stand_on_crossing_from_port_waits_for_rule_17_then_takes_the_way_off() {
+        // From 10.7 m off tug 2, beyond d_D, crossing the route 6 m ahead in 60 s.
+        let rows = stand_on_run(200, (6.0, 60.0), (90.0, 10.0 / 60.0));
+        let tcpa = GuidanceSettings::default().colregs.rule17.tcpa;
+        let first = rows.iter().find(|r| r.3).expect("the way is taken off");
+        // Kept course and speed until Rule 17 allowed action, then acted at once,
+        // though the target was still beyond d_D (Rule 17 is judged by the CPA).
+        assert!(rows.iter().take_while(|r| !r.3).all(|r| r.1 > tcpa));
+        assert!(first.1 <= tcpa && first.1 > tcpa - 1.5, "{first:?}");
+        // The route is never altered: the way-off lets the target pass ahead.
+        assert!(rows.iter().all(|r| !r.2));
+        // Held without a break until the target is clear of the tow, then released.
+        let last = rows.iter().rposition(|r| r.3).unwrap();
+        assert!(rows[..=last].iter().skip_while(|r| !r.3).all(|r| r.3));
+        assert!(
+            rows[last + 1].4,
+            "released once past and clear: {:?}",
+            rows[last + 1]
+        );
+        assert!(rows.len() > last + 1, "released within the encounter");
+        // Out of the MPC's distance cost while the way is off (its action) and, once
+        // past and clear with the resumed track passing the target clear, for the rest
+        // of the encounter (here 40 s).
+        let from = rows.iter().position(|r| r.3).unwrap();
+        assert!(rows[from..last + 40].iter().all(|r| r.5), "{rows:?}");
+    }
+
+    #[test]
+    fn a_stand_on_tow_alters_when_slowing_would_not_pass_the_target_farther() {
+        // A tow restricted in her ability to manoeuvre stands on for a head-on target
+        // (Rule 18); the target's track runs over the tow whether she slows or not, so
+        // Rule 17's action is the starboard alteration.
+        use crate::colregs::TowStatus;
+        let mut settings = GuidanceSettings::default();
+        settings.colregs.tow_status = TowStatus::RestrictedInAbilityToManoeuvre;
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::new(settings).unwrap());
+        let target = vessel(14.0, 0.0, PI, 0.1);
+        let mut acted = None;
+        for t in 0..20 {
+            let t = f64::from(t);
+            let tow = tow_at(Pose::new(0.1 * t, 0.0, 0.0), 0.1);
+            let out = rs.update(&tow, &[moved(target, t)]).unwrap();
+            let g = out.governing.unwrap();
+            assert_eq!(g.action, Action::StandOnThenAct);
+            assert!(!out.way_off, "t = {t}: {out:?}");
+            if out.altered && acted.is_none() {
+                acted = Some(g.encounter.unwrap().cpa.tcpa);
             }
         }
-        let first = first_altered.unwrap();
-        assert!((29.0..=31.0).contains(&first), "{first}");
+        let tcpa = acted.expect("the route is altered");
+        assert!(tcpa <= settings.colregs.rule17.tcpa && tcpa > settings.colregs.rule17.tcpa - 1.5);
     }
 
     #[test]
