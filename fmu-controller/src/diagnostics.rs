@@ -54,6 +54,8 @@ pub const ACTIVE_WAYPOINT: u32 = 3030;
 pub const ALTERED: u32 = 3031;
 /// `guidance.d_ob` (Real output, m).
 pub const D_OB: u32 = 3032;
+/// `guidance.way_off` (Boolean output).
+pub const WAY_OFF: u32 = 3033;
 /// `towline1/2.angle_desired` (Real outputs, rad), line 0 or 1.
 pub const fn angle_desired(line: u32) -> u32 {
     3040 + line
@@ -92,6 +94,7 @@ pub struct Outputs {
     pub(crate) reference: [f64; 3],
     pub(crate) active_waypoint: i32,
     pub(crate) altered: bool,
+    pub(crate) way_off: bool,
     pub(crate) d_ob: f64,
     pub(crate) angle_desired: [f64; 2],
     pub(crate) situation: [i32; MAX_OBSTACLES],
@@ -115,6 +118,7 @@ impl Default for Outputs {
             reference: [0.0; 3],
             active_waypoint: 0,
             altered: false,
+            way_off: false,
             d_ob: NO_OBSTACLE_DISTANCE,
             angle_desired: [0.0; 2],
             situation: [-1; MAX_OBSTACLES],
@@ -142,6 +146,7 @@ impl Outputs {
         self.reference = r.reference;
         self.active_waypoint = saturating_i32(r.guidance.active_waypoint);
         self.altered = r.guidance.altered;
+        self.way_off = r.guidance.way_off;
         self.d_ob = if r.guidance.d_ob.is_finite() {
             r.guidance.d_ob.min(NO_OBSTACLE_DISTANCE)
         } else {
@@ -432,6 +437,12 @@ fn guidance() -> Vec<Diagnostic> {
         "true when the reference is the altered waypoint eta_Sn (eq. (10)-(11))".into(),
         |o| o.altered,
     ));
+    v.push(Diagnostic::boolean(
+        "guidance.way_off".into(),
+        WAY_OFF,
+        "true while the stand-on tow keeps the way off for a target under Rule 17 (docs/colregs.md, \"Rule 17: which action\"); the route is then kept".into(),
+        |o| o.way_off,
+    ));
     v.push(Diagnostic::real(
         "guidance.d_ob".into(),
         D_OB,
@@ -547,7 +558,7 @@ mod tests {
         }
         assert_eq!(
             DIAGNOSTICS.len(),
-            2 + 4 + 4 + 3 + 3 + 2 + 2 * MAX_OBSTACLES + 6 * HORIZON
+            2 + 4 + 4 + 3 + 4 + 2 + 2 * MAX_OBSTACLES + 6 * HORIZON
         );
     }
 }

@@ -100,8 +100,8 @@ fn outputs_hold_their_start_values_until_the_first_step() {
         }
         checked += 1;
     }
-    // 8 commands, 18 diagnostics, 8 x 2 COLREGS, 3 x 3 x 2 predictions.
-    assert_eq!(checked, 8 + 18 + 16 + 18);
+    // 8 commands, 19 diagnostics, 8 x 2 COLREGS, 3 x 3 x 2 predictions.
+    assert_eq!(checked, 8 + 19 + 16 + 18);
 }
 
 #[test]
