@@ -299,19 +299,7 @@ pub fn assess_obstacle(
             m => m,
         },
     };
-    let resume_clear = match (obstacle, context.resume_speed) {
-        (ActiveObstacle::Vessel(target), Some(speed)) => {
-            let (sin, cos) = tow.ship.psi.sin_cos();
-            clearance_margin(
-                params,
-                &vessels,
-                target,
-                [0.0; 2],
-                [speed * cos, speed * sin],
-            ) >= 0.0
-        }
-        _ => true,
-    };
+    let resume_clear = resume_clear(params, tow, &vessels, obstacle, context.resume_speed);
     ObstacleAssessment {
         index,
         kind: obstacle.kind(),
@@ -415,6 +403,26 @@ fn way_off_chosen(
         [speed * cos, speed * sin],
     );
     slowed > 0.0 || slowed > clearance_margin(params, vessels, target, [0.0; 2], tow.ship_vel_n)
+}
+
+/// [`ObstacleAssessment::resume_clear`]: with the way off for `obstacle` (a resume
+/// speed), the tow resuming at that speed along the ship's heading passes it clear of
+/// every vessel ([`clearance_margin`] at least 0); true otherwise.
+fn resume_clear(
+    params: &GuidanceParams,
+    tow: &TowState,
+    vessels: &[(TowVessel, [f64; 2], f64); 3],
+    obstacle: &ActiveObstacle,
+    resume_speed: Option<f64>,
+) -> bool {
+    match (obstacle, resume_speed) {
+        (ActiveObstacle::Vessel(target), Some(speed)) => {
+            let (sin, cos) = tow.ship.psi.sin_cos();
+            let v_own = [speed * cos, speed * sin];
+            clearance_margin(params, vessels, target, [0.0; 2], v_own) >= 0.0
+        }
+        _ => true,
+    }
 }
 
 /// The smallest margin (m) over the vessels of the tow between the range-equivalent
