@@ -674,18 +674,21 @@ impl Controller {
         // 37-55 deg) as she slowed and turned.
         // Rule 17(a)(ii), (b) with 8(e): a stand-on tow that must act and can let the
         // target pass ahead takes the way off the same way, down to `way_off_speed`.
-        let slowing = m.ship[3] - t.tracking.give_way_deceleration * t.prediction.sample_time;
-        let give_way_cap = (giving_way && t.tracking.give_way_way_off)
-            .then(|| t.tracking.give_way_surge.max(slowing));
-        let rule17 = &t.guidance.colregs.rule17;
-        let rule17_cap = (guidance.way_off && t.scheme.alters()).then(|| {
-            let slowing = m.ship[3] - rule17.way_off_deceleration * t.prediction.sample_time;
-            rule17.way_off_speed.max(slowing)
-        });
-        let max_surge = match (give_way_cap, rule17_cap) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
+        // Both caps take the way off the same way: the measured surge less the
+        // deceleration times T_s, down to a floor.
+        let cap = |floor: f64, deceleration: f64| {
+            floor.max(m.ship[3] - deceleration * t.prediction.sample_time)
         };
+        let rule17 = &t.guidance.colregs.rule17;
+        let max_surge = [
+            (giving_way && t.tracking.give_way_way_off)
+                .then(|| cap(t.tracking.give_way_surge, t.tracking.give_way_deceleration)),
+            (guidance.way_off && t.scheme.alters())
+                .then(|| cap(rule17.way_off_speed, rule17.way_off_deceleration)),
+        ]
+        .into_iter()
+        .flatten()
+        .reduce(f64::min);
         let heading_floor = self.heading_floor(m.ship[2]);
         let reference = self.reference(
             &m.ship,

@@ -70,6 +70,12 @@ pub struct TowState {
 }
 
 impl TowState {
+    /// The ship's speed over ground along her heading (m/s).
+    fn speed_ahead(&self) -> f64 {
+        let (sin, cos) = self.ship.psi.sin_cos();
+        self.ship_vel_n[0] * cos + self.ship_vel_n[1] * sin
+    }
+
     fn validate(&self) -> Result<(), InputError> {
         let fields = [
             ("ship.x", self.ship.x),
@@ -393,7 +399,7 @@ fn way_off_chosen(
     // The headway carried while slowing from the present speed along the heading,
     // taken at once (the tow ahead of where it will be: the safe side for a target
     // crossing ahead of it).
-    let u = tow.ship_vel_n[0] * cos + tow.ship_vel_n[1] * sin;
+    let u = tow.speed_ahead();
     let headway = (u * u - speed * speed).max(0.0) / (2.0 * rule17.way_off_deceleration);
     let slowed = clearance_margin(
         params,
@@ -743,10 +749,7 @@ impl ReferenceSystem {
         let keeps_way_off = slowed && !finally_clear && (near || closing);
         if a.manoeuvre == Manoeuvre::TakeWayOff || keeps_way_off {
             next.way_off |= bit;
-            next.resume_speed[a.index] = context.resume_speed.unwrap_or_else(|| {
-                let (sin, cos) = tow.ship.psi.sin_cos();
-                tow.ship_vel_n[0] * cos + tow.ship_vel_n[1] * sin
-            });
+            next.resume_speed[a.index] = context.resume_speed.unwrap_or_else(|| tow.speed_ahead());
         }
         // A way-off taken under Rule 17 (judged by the CPA, possibly beyond d_D) keeps
         // the encounter open, up to the sample that releases it.
