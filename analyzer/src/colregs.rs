@@ -6,7 +6,8 @@
 //! Angles: bearings in `(-180, 180]` deg, positive to starboard (NED, clockwise).
 //! `beta` is the bearing of the target from own bow, `alpha` the bearing of own ship from
 //! the target's bow (contact angle). Own ship is the towed ship (the tow's COLREGS
-//! identity, `docs/colregs.md`); its course is its heading.
+//! identity, `docs/colregs.md`); its course is its heading, and a course change is the
+//! heading's change less the route's own ([`EncounterSample::route_course`]).
 
 use serde::{Deserialize, Serialize};
 
@@ -99,6 +100,17 @@ pub struct EncounterSample {
     /// the tow detects a target by its nearest vessel (eq. (8)), which can be a tug well
     /// before the ship.
     pub tow_range: f64,
+    /// The route's course at own position, rad ([`crate::geometry::RouteCourse`]; 0
+    /// without a route): course changes are the heading's change less this one's (a
+    /// bend of the route is no alteration).
+    pub route_course: f64,
+}
+
+impl EncounterSample {
+    /// Own heading off the route's course, rad.
+    fn off_course(&self) -> f64 {
+        self.own[2] - self.route_course
+    }
 }
 
 /// The COLREGS situation: the guidance's (codes as the controller FMU's
@@ -332,8 +344,8 @@ pub struct ControllerView {
 /// The heading changes and the first action from the tow's detection up to a sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Window {
-    /// Own heading when the tow detected the target, rad.
-    base_psi: f64,
+    /// Own heading off the route's course when the tow detected the target, rad.
+    base_off_course: f64,
     /// Largest heading change to starboard so far, deg.
     stbd: f64,
     /// Largest heading change to port so far, deg.
@@ -405,7 +417,7 @@ impl EncounterTracker {
         if self.window.is_none() && (range < self.p.r_detect_m || s.tow_range < self.p.r_detect_m) {
             self.detect_tow = Some(s);
             self.window = Some(Window {
-                base_psi: s.own[2],
+                base_off_course: s.off_course(),
                 stbd: 0.0,
                 port: 0.0,
                 was_altered: s.altered.unwrap_or(false),
@@ -413,7 +425,7 @@ impl EncounterTracker {
             });
         }
         if let Some(w) = &mut self.window {
-            let dev = wrap(s.own[2] - w.base_psi).to_degrees();
+            let dev = wrap(s.off_course() - w.base_off_course).to_degrees();
             w.stbd = w.stbd.max(dev);
             w.port = w.port.max(-dev);
             let altered = s.altered.unwrap_or(false);
@@ -483,7 +495,7 @@ impl EncounterTracker {
         let det = self.detect_tow.unwrap_or(det_ship);
         report.t_detect_tow_s = Some(det.t);
         let window = cpa_rec.window.unwrap_or(Window {
-            base_psi: det.own[2],
+            base_off_course: det.off_course(),
             stbd: 0.0,
             port: 0.0,
             was_altered: false,
@@ -804,7 +816,7 @@ mod tests {
         let altered_at_detection = det.altered.unwrap_or(false);
         let mut was_altered = altered_at_detection;
         for (i, s) in samples.iter().enumerate().take(i_cpa + 1).skip(i_tow) {
-            let dev = wrap(s.own[2] - det.own[2]).to_degrees();
+            let dev = wrap(s.off_course() - det.off_course()).to_degrees();
             stbd = stbd.max(dev);
             port = port.max(-dev);
             let altered = s.altered.unwrap_or(false);
@@ -889,6 +901,7 @@ mod tests {
                 ],
                 altered: Some(t >= t_turn && turn != 0.0),
                 tow_range: f64::INFINITY,
+                route_course: 0.0,
             });
             x += u * dt * psi.cos();
             y += u * dt * psi.sin();
@@ -1043,6 +1056,7 @@ mod tests {
                         } else {
                             range - 2.0 * r()
                         },
+                        route_course: 0.0,
                     }
                 })
                 .collect();

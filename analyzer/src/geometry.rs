@@ -14,6 +14,44 @@ pub use towing_model::geometry::{
 /// A point `[north, east]`, m.
 pub type P2 = towing_model::geometry::Point;
 
+/// The course of the tow's manoeuvre, against which her course changes are measured:
+/// following her route ([`Polyline::course_ahead`], `route_course_lookahead_m` ahead).
+/// COLREGS Rule 17's "course" is that of the manoeuvre the vessel is engaged in, not
+/// her compass heading when the other is sighted (Windsor-Roanoke, 1908; Cockcroft and
+/// Lameijer, *A Guide to the Collision Avoidance Rules*, on Rule 17): a tow rounding a
+/// bend of her route keeps her course, and a turn counts only as far as it leaves the
+/// route's course (`docs/analyzer.md`, "Course changes"). Without a route (fewer than
+/// two distinct points) the course is 0 and a change of it is a change of heading.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RouteCourse {
+    route: Option<Polyline>,
+    lookahead: f64,
+}
+
+impl RouteCourse {
+    /// The course of following `route` (points North, East, heading) seen `lookahead` m
+    /// ahead.
+    #[must_use]
+    pub fn new(route: &[[f64; 3]], lookahead: f64) -> Self {
+        RouteCourse {
+            route: Polyline::from_route(route),
+            lookahead,
+        }
+    }
+
+    /// The route's course (rad) at `p`; 0 without a route or at a non-finite `p`.
+    #[must_use]
+    pub fn at(&self, p: P2) -> f64 {
+        if !(p[0].is_finite() && p[1].is_finite()) {
+            return 0.0;
+        }
+        self.route
+            .as_ref()
+            .and_then(|r| r.course_ahead(p, self.lookahead))
+            .unwrap_or(0.0)
+    }
+}
+
 /// Wraps an angle to `(-pi, pi]`.
 #[must_use]
 pub fn wrap(a: f64) -> f64 {

@@ -61,6 +61,10 @@ pub struct Thresholds {
     pub port_turn_max_deg: f64,
     /// Overtaking: least hull clearance, m.
     pub overtaking_clearance_m: f64,
+    /// Course changes are measured against the route's course, seen this far ahead along
+    /// the route from the ship's nearest point on it, m ([`crate::geometry::RouteCourse`]):
+    /// the distance in which the tow rounds a bend.
+    pub route_course_lookahead_m: f64,
 }
 
 impl Default for Thresholds {
@@ -86,6 +90,7 @@ impl Default for Thresholds {
             rule17_tcpa_s: 60.0,
             port_turn_max_deg: 5.0,
             overtaking_clearance_m: 0.25,
+            route_course_lookahead_m: 3.5,
         }
     }
 }
@@ -93,7 +98,7 @@ impl Default for Thresholds {
 impl Thresholds {
     /// Every threshold with its name, in declaration order.
     #[must_use]
-    pub fn entries(&self) -> [(&'static str, f64); 20] {
+    pub fn entries(&self) -> [(&'static str, f64); 21] {
         [
             ("progress_min_m", self.progress_min_m),
             ("destination_radius_m", self.destination_radius_m),
@@ -115,6 +120,7 @@ impl Thresholds {
             ("rule17_tcpa_s", self.rule17_tcpa_s),
             ("port_turn_max_deg", self.port_turn_max_deg),
             ("overtaking_clearance_m", self.overtaking_clearance_m),
+            ("route_course_lookahead_m", self.route_course_lookahead_m),
         ]
     }
 

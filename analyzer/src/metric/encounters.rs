@@ -13,6 +13,7 @@ use crate::colregs::{
 use crate::doc::{num, Block};
 use crate::error::Result;
 use crate::frames::{ControllerFrames, PlantBatch};
+use crate::geometry::RouteCourse;
 use crate::rows::{slot_index, ObstacleRows};
 use crate::thresholds::Thresholds;
 use crate::verdict::Reason;
@@ -42,13 +43,15 @@ pub struct Encounters {
     ship_length: f64,
     detection: f64,
     safety_buffer: f64,
+    /// The route's course, against which course changes are measured.
+    course: RouteCourse,
     slots: Vec<Slot>,
     /// The reports, once concluded ([`Metric::share`]).
     reports: Option<Vec<EncounterReport>>,
 }
 
 impl Slot {
-    fn push(&mut self, rows: &ObstacleRows<'_>, i: usize, window: f64) {
+    fn push(&mut self, rows: &ObstacleRows<'_>, i: usize, (window, course): (f64, &RouteCourse)) {
         let Some(tracker) = &mut self.tracker else {
             return;
         };
@@ -61,6 +64,7 @@ impl Slot {
             target: [ox, oy, opsi, ospeed],
             altered: rows.altered[i],
             tow_range: dist[0].min(dist[1]).min(dist[2]),
+            route_course: course.at([p[0], p[1]]),
         };
         let usable = sample
             .own
@@ -141,6 +145,7 @@ impl Metric for Encounters {
             ship_length: run.config.ship_size[0],
             detection: run.config.detection_distance_m,
             safety_buffer: run.config.safety_buffer_m,
+            course: RouteCourse::new(&run.geometry.route, run.thresholds.route_course_lookahead_m),
             slots: Vec::new(),
             reports: None,
         }
@@ -167,7 +172,7 @@ impl Metric for Encounters {
                     closest: None,
                 },
             );
-            self.slots[k].push(&rows, i, window);
+            self.slots[k].push(&rows, i, (window, &self.course));
         }
         Ok(())
     }

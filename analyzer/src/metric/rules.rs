@@ -8,7 +8,10 @@
 //! situation for the slot (neither safe nor unclassified, `step.control`) is recorded too.
 //! The checks use the controller's when it has one, else the geometric one, and the report
 //! says which. Every check is measured for every target from its detection (O(1) state per
-//! target); the situation picks the ones that count at the verdict ([`reasons`]):
+//! target); the situation picks the ones that count at the verdict ([`reasons`]). Course
+//! changes ("turn", "course") are the heading's change less the route's own change
+//! ([`RouteCourse`]: Rule 17's "course" is that of the manoeuvre the tow is engaged in, so
+//! rounding a bend of the route is no alteration, to port or to starboard):
 //!
 //! - give-way (Rule 16; head-on, crossing give-way, overtaking): action before the CPA, a
 //!   course alteration of at least `give_way_turn_deg` to starboard from the heading at
@@ -32,9 +35,11 @@
 //! Past and clear (Rule 8(d)) is judged from the target's own motion relative to the tow,
 //! never from a range opened by the tow's braking: in a crossing, the target has crossed
 //! the ship's heading line ahead of the ship by its own motion (between two steps it went
-//! from one side to the other of the line through the ship's pose at the earlier step, and
-//! is ahead of the ship: the line is held still over the step, so neither the tow's turn
-//! nor its sideways motion can make the crossing); in any situation, it is abaft the ship's
+//! from one side of the line to the other and is ahead of the ship, and its own
+//! displacement across the earlier step's line, held still, is at least half of the change
+//! of its side, [`crate::geometry::crossed_ahead`]: neither the tow's turn nor its sideways
+//! motion alone makes the crossing, and the verdict does not depend on the step size); in
+//! any situation, it is abaft the ship's
 //! beam with the range opening while the tow makes way (surge > `way_off_surge_m_s`). A
 //! head-on or overtaking target moves along the tow's track, not across it: its side of the
 //! heading line changes with a wobble of either vessel, so only the second test applies.
@@ -50,7 +55,7 @@ use crate::geometry::{
 };
 use crate::rows::VESSELS;
 use crate::colregs::{classify, Situation};
-use crate::geometry::{dist, relative_bearing, wrap};
+use crate::geometry::{dist, relative_bearing, wrap, RouteCourse};
 use crate::step::{Obstacle, ObstacleKind, PlantStep, RunGeometry, Vessel};
 use crate::thresholds::Thresholds;
 use crate::verdict::Reason;
@@ -157,7 +162,9 @@ pub struct RulesReport {
 /// The state at the tow's detection.
 #[derive(Debug, Clone, Copy)]
 struct Detection {
-    psi: f64,
+    /// The ship's heading less the route's course ([`RouteCourse`]), rad: course changes
+    /// are measured from it.
+    off_course: f64,
     sog: f64,
     geometric: Situation,
 }
@@ -258,7 +265,7 @@ impl Target {
     }
 
     /// Detection at this step if any vessel of the tow is within `d_detect`.
-    fn detect(&mut self, t: f64, ship: &Vessel, vessels: &[Vessel; 3], o: &Obstacle, d: f64) {
+    fn detect(&mut self, t: f64, (ship, course): (&Vessel, f64), vessels: &[Vessel; 3], o: &Obstacle, d: f64) {
         let tp = [o.x, o.y];
         if self.det.is_some() || !vessels.iter().any(|v| dist([v.x, v.y], tp) < d) {
             return;
@@ -268,7 +275,7 @@ impl Target {
         let alpha = relative_bearing(tp, o.course, sp).to_degrees();
         let geometric = classify(beta, alpha, ship.sog(), o.speed);
         self.det = Some(Detection {
-            psi: ship.psi,
+            off_course: ship.psi - course,
             sog: ship.sog(),
             geometric,
         });
@@ -280,14 +287,15 @@ impl Target {
     }
 
     /// One step of the checks after detection.
-    fn observe(&mut self, t: f64, tow: Tow<'_>, o: &Obstacle, th: &Thresholds) {
+    fn observe(&mut self, t: f64, (tow, course): (Tow<'_>, f64), o: &Obstacle, th: &Thresholds) {
         let Some(det) = self.det else { return };
         let ship = tow.0[0];
         let (sp, tp) = ([ship.x, ship.y], [o.x, o.y]);
         let v_target = course_velocity(o.course, o.speed);
         let range = dist(sp, tp);
         let beta = relative_bearing(sp, ship.psi, tp).to_degrees();
-        let turn = wrap(ship.psi - det.psi).to_degrees();
+        // The course change: the heading's, less the route's own turn (a bend).
+        let turn = wrap(ship.psi - course - det.off_course).to_degrees();
         self.stbd_max = self.stbd_max.max(turn);
         if self.r.r_cpa_m.is_none_or(|r| range < r) {
             self.r.t_cpa_s = Some(t);
@@ -296,7 +304,7 @@ impl Target {
             self.r.starboard_turn_to_cpa_deg = Some(self.stbd_max);
         }
         self.past_and_clear(t, &ship, o, th);
-        self.give_way_action(t, &ship, range, beta, th);
+        self.give_way_action(t, &ship, (range, beta, turn), th);
         self.cross_ahead(t, tow.0, o, th);
         self.stand_on(t, &ship, v_target, o, (turn, beta), th);
         self.clearance(t, tow, o);
@@ -313,12 +321,9 @@ impl Target {
             self.situation(),
             Some(Situation::HeadOn | Situation::Overtaking | Situation::BeingOvertaken)
         );
-        // The line through the ship's previous pose, held still over the step: only the
-        // target's own motion moves it across.
-        let crossed = crossing
-            && prev.is_some_and(|(p_ship, p_psi, p_target)| {
-                crossed_ahead(p_ship, p_psi, p_target, tp)
-            });
+        // From one side of the ship's heading line to the other, its own motion at least
+        // half of the change: the tow's turn alone never makes the crossing.
+        let crossed = crossing && prev.is_some_and(|p| crossed_ahead(p, (sp, ship.psi, tp)));
         let beta = relative_bearing(sp, ship.psi, tp);
         let opening = range_rate(sp, ship.vel_n(), tp, course_velocity(o.course, o.speed)) > 0.0;
         let abaft =
@@ -337,9 +342,16 @@ impl Target {
     }
 
     /// Rule 16 and 8(d): the first action, and its release before past and clear.
-    fn give_way_action(&mut self, t: f64, ship: &Vessel, range: f64, beta: f64, th: &Thresholds) {
-        let Some(det) = self.det else { return };
-        let turn = wrap(ship.psi - det.psi).to_degrees();
+    fn give_way_action(
+        &mut self,
+        t: f64,
+        ship: &Vessel,
+        (range, beta, turn): (f64, f64, f64),
+        th: &Thresholds,
+    ) {
+        if self.det.is_none() {
+            return;
+        }
         let turned = turn >= th.give_way_turn_deg;
         let way_off = ship.u <= th.way_off_surge_m_s;
         let acting = turned || way_off;
@@ -480,6 +492,7 @@ pub fn is_stand_on(s: Situation) -> bool {
 #[derive(Debug, Clone)]
 pub struct RulesTracker {
     th: Thresholds,
+    course: RouteCourse,
     sizes: [[f64; 2]; 3],
     d_detect: f64,
     targets: Vec<Target>,
@@ -491,6 +504,7 @@ impl RulesTracker {
     pub fn new(geometry: &RunGeometry, thresholds: &Thresholds) -> Self {
         RulesTracker {
             th: *thresholds,
+            course: RouteCourse::new(&geometry.route, thresholds.route_course_lookahead_m),
             sizes: geometry.sizes,
             d_detect: geometry.detection_distance,
             targets: Vec::new(),
@@ -503,6 +517,7 @@ impl RulesTracker {
             t.present = false;
         }
         let ship = step.vessels[0];
+        let course = self.course.at([ship.x, ship.y]);
         for o in step
             .obstacles
             .iter()
@@ -518,8 +533,8 @@ impl RulesTracker {
             let target = &mut self.targets[k];
             target.present = true;
             target.watch_controller(step);
-            target.detect(step.t, &ship, &step.vessels, o, self.d_detect);
-            target.observe(step.t, (&step.vessels, &self.sizes), o, &self.th);
+            target.detect(step.t, (&ship, course), &step.vessels, o, self.d_detect);
+            target.observe(step.t, ((&step.vessels, &self.sizes), course), o, &self.th);
         }
         // The controller may report a target's situation before it is among the active
         // obstacles of a step only in a malformed log; such reports are not kept.

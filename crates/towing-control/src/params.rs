@@ -593,6 +593,18 @@ pub static PARAMETERS: &[Parameter] = &[
         },
     },
     Parameter {
+        name: "guidance.resume_speed",
+        old_name: None,
+        description: "Speed at which the tow is taken to resume her route when the guidance judges whether a target she acted for (alteration or way off) is finally past and clear (COLREGS Rule 8(d)): the action is held while the resumed track would not pass the target clear; 0.1 m/s, the paper's tow speed (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "m/s",
+            min: Limit::Above(0.0),
+            max: Limit::None,
+            get: |t| t.guidance.resume_speed,
+            set: |t, v| t.guidance.resume_speed = v,
+        },
+    },
+    Parameter {
         name: "guidance.safety_buffer",
         old_name: Some("safety_buffer"),
         description: "Buffer d_S0 of the safe distance, eq. (14); not given by the paper, 0.25 m (a fifth of a ship length, docs/assumptions.md)",

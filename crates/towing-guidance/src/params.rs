@@ -70,6 +70,15 @@ pub struct GuidanceSettings {
     /// (0.17 m/s): it stops the reference from chattering at the threshold. The
     /// paper's eq. (8) has no hysteresis.
     pub release_margin: f64,
+    /// Speed (m/s) at which the tow is taken to resume her route when the reference
+    /// system judges whether a target it acted for is finally past and clear (Rule
+    /// 8(d)): the tow, at this speed along the active leg from where she is, must pass
+    /// the target clear before the action ends.
+    ///
+    /// Assumption: 0.1 m/s, the paper's tow speed (its figures; the MPC's surge soft
+    /// limit is 0.11 m/s). The speed she had when she acted is no measure: a tow that
+    /// acted at the start of a run was at rest.
+    pub resume_speed: f64,
     /// Buffer `d_S0` (m) of eq. (14), used for the safe distances reported.
     ///
     /// Assumption: 0.25 m (a fifth of a ship length). The paper gives none. Its
@@ -117,6 +126,7 @@ impl Default for GuidanceSettings {
             static_detection_distance: 2.5,
             static_hazard_policy: StaticHazardPolicy::WhenAlteringHelps,
             release_margin: 0.5,
+            resume_speed: 0.1,
             safety_buffer: 0.25,
             altering_angle: 15f64.to_radians(),
             waterway_half_width: None,
@@ -188,6 +198,7 @@ impl GuidanceParams {
             s.release_margin >= 0.0,
             "finite and >= 0",
         )?;
+        check("resume_speed", s.resume_speed, s.resume_speed > 0.0, pos)?;
         check(
             "safety_buffer",
             s.safety_buffer,
@@ -259,6 +270,7 @@ mod tests {
             "static_detection_distance"
         );
         assert_eq!(bad(|s| s.release_margin = -0.1), "release_margin");
+        assert_eq!(bad(|s| s.resume_speed = 0.0), "resume_speed");
         assert_eq!(bad(|s| s.safety_buffer = f64::INFINITY), "safety_buffer");
         assert_eq!(bad(|s| s.altering_angle = -0.1), "altering_angle");
         assert_eq!(bad(|s| s.altering_angle = 1.6), "altering_angle");

@@ -24,16 +24,19 @@
 //!    takes the way off ([`Manoeuvre::TakeWayOff`], route kept) if the slowed tow lets
 //!    the target pass clear ahead, else it demands the alteration. A way-off is held
 //!    like an alteration (step 3) and reported in [`GuidanceOutput::way_off`].
-//! 3. An obstacle that demanded the alteration keeps it until its distance exceeds
-//!    its detection distance plus `release_margin` (for a static hazard: or the
-//!    alteration no longer helps, on a new segment) (the encounter is over; Rule
-//!    8(d): "until the other vessel is finally past and clear"), even if its
-//!    situation has meanwhile become safe; a target ship also releases it, inside
-//!    that distance, once it is past and clear ([`past_and_clear`]: the range from
-//!    every vessel of the tow opening and beyond that vessel's eq. (14) safe range
-//!    plus `release_margin`). Such an encounter stays over until the target leaves
-//!    the encounter distance, unless it closes again into a situation in which Rule 17
-//!    would act (its TCPA and DCPA limits).
+//! 3. An obstacle that demanded the alteration keeps it (Rule 8(d): "until the other
+//!    vessel is finally past and clear"). A static hazard keeps it until its distance
+//!    exceeds its detection distance plus `release_margin`, or the alteration no longer
+//!    helps (a new segment). A target ship keeps it, and a way-off likewise, until it
+//!    is finally past and clear: past and clear ([`past_and_clear`]: crossed ahead by
+//!    its own motion or abaft the beam, the range from every vessel of the tow opening
+//!    and beyond that vessel's eq. (14) safe range plus `release_margin`) and the tow
+//!    resuming her route would pass it clear ([`resume_clear`]); or until it has left
+//!    (beyond the distance plus `release_margin`, not closing, clear of the resumed
+//!    track), even if its situation has meanwhile become safe. An encounter found past
+//!    and clear stays over until the target leaves the encounter distance, unless it
+//!    closes again into a situation in which Rule 17 would act (its TCPA and DCPA
+//!    limits).
 //! 4. While any obstacle keeps it, the reference is the active waypoint rotated to
 //!    starboard about the previous predefined waypoint (eq. (10)-(11)); otherwise the
 //!    predefined waypoint (eq. (8), `eta_Sd = eta_Sp`).
@@ -149,9 +152,9 @@ pub struct ObstacleAssessment {
     /// What it asks of the reference system now (detection, Rule 17 and
     /// `past_and_clear` applied).
     pub manoeuvre: Manoeuvre,
-    /// With the way off for this target ([`AssessContext::resume_speed`]): the tow
-    /// resuming at that speed along her heading would pass it clear of every vessel
-    /// ([`clearance_margin`] at least 0). True otherwise.
+    /// With an action held for this target (an alteration or the way off,
+    /// [`AssessContext::acting`]): the tow resuming her route would pass it clear of
+    /// every vessel ([`resume_clear`]). True otherwise.
     pub resume_clear: bool,
 }
 
@@ -179,15 +182,17 @@ pub struct AssessContext {
     /// ([`Manoeuvre::TakeWayOff`]) and keeps it off: an action once taken is held,
     /// not changed into an alteration (Rule 8(a), (d)).
     pub way_off: bool,
-    /// With the way off for this target: the ship's speed along her heading when she
-    /// took it off, at which the release predicts her resumed track.
-    pub resume_speed: Option<f64>,
+    /// An action is held for this target: the route altered for it, or the way off
+    /// ([`Self::way_off`]). Its release asks whether the resumed track passes it clear
+    /// ([`ObstacleAssessment::resume_clear`]).
+    pub acting: bool,
 }
 
 /// The ship's pose and a target's position at one sample: the next sample tells from
-/// it whether the target crossed the ship's heading line ahead of her by its own
-/// motion (the line is the one through the ship's pose of this sample, held still, so
-/// neither the tow's turn nor its sideways motion can make the crossing).
+/// it whether the target crossed the ship's heading line ahead of her by its own motion
+/// ([`towing_model::geometry::crossed_ahead`]: its own displacement across this
+/// sample's line, held still, is at least half of the change of its side; neither the
+/// tow's turn nor its sideways motion alone makes the crossing).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Sighting {
     /// Ship pose.
@@ -197,16 +202,14 @@ pub struct Sighting {
 }
 
 impl Sighting {
-    /// True when `target_now` lies on the other side of this sighting's heading line
-    /// than the target did, and ahead of the ship ([`towing_model::geometry::crossed_ahead`],
-    /// the analyzer's test too).
+    /// True when the target, now at `target_now` with the ship at `ship_now`, has crossed
+    /// the ship's heading line ahead of her by its own motion since this sighting
+    /// ([`towing_model::geometry::crossed_ahead`], the analyzer's test too).
     #[must_use]
-    pub fn crossed_ahead(&self, target_now: [f64; 2]) -> bool {
+    pub fn crossed_ahead(&self, ship_now: Pose, target_now: [f64; 2]) -> bool {
         towing_model::geometry::crossed_ahead(
-            self.ship.position(),
-            self.ship.psi,
-            self.target,
-            target_now,
+            (self.ship.position(), self.ship.psi, self.target),
+            (ship_now.position(), ship_now.psi, target_now),
         )
     }
 }
@@ -273,7 +276,7 @@ pub fn assess_obstacle(
     let crossed = context.crossed
         || context
             .previous
-            .is_some_and(|p| p.crossed_ahead(obstacle.centre()));
+            .is_some_and(|p| p.crossed_ahead(tow.ship, obstacle.centre()));
     let past_and_clear = encounter.zip(situation).is_some_and(|(enc, situation)| {
         (context.cleared && !s.colregs.rule17.give_way_failed(&enc.cpa))
             || past_and_clear(
@@ -289,10 +292,8 @@ pub fn assess_obstacle(
     let rule17 = &s.colregs.rule17;
     let rule17_acts = policy == Action::StandOnThenAct
         && encounter.is_some_and(|enc| rule17.give_way_failed(&enc.cpa));
-    let manoeuvre = match (
-        (detected || rule17_acts) && alteration_allowed && !past_and_clear,
-        &encounter,
-    ) {
+    let acts = (detected || rule17_acts) && alteration_allowed && !past_and_clear;
+    let manoeuvre = match (acts, &encounter) {
         (false, _) => Manoeuvre::FollowRoute,
         (true, None) => Manoeuvre::AlterToStarboard,
         (true, Some(enc)) => match policy.manoeuvre(&enc.cpa, rule17) {
@@ -305,7 +306,8 @@ pub fn assess_obstacle(
             m => m,
         },
     };
-    let resume_clear = resume_clear(params, tow, &vessels, obstacle, context.resume_speed);
+    let resume_clear =
+        !context.acting || resume_clear(params, tow, &vessels, obstacle, context.leg);
     ObstacleAssessment {
         index,
         kind: obstacle.kind(),
@@ -411,24 +413,35 @@ fn way_off_chosen(
     slowed > 0.0 || slowed > clearance_margin(params, vessels, target, [0.0; 2], tow.ship_vel_n)
 }
 
-/// [`ObstacleAssessment::resume_clear`]: with the way off for `obstacle` (a resume
-/// speed), the tow resuming at that speed along the ship's heading passes it clear of
-/// every vessel ([`clearance_margin`] at least 0); true otherwise.
+/// [`ObstacleAssessment::resume_clear`]: the tow resuming her route, at
+/// [`crate::GuidanceSettings::resume_speed`] along the active leg `W_{p-1} -> W_p` of
+/// `leg` (along the ship's heading without it) from where her vessels are now, passes
+/// `obstacle`, a target keeping its course and speed, clear of every vessel
+/// ([`clearance_margin`] at least 0); true for a static hazard. Rule 8(d): the action
+/// lasts until the other vessel is *finally* past and clear, so not while giving it up
+/// would bring the tow back into a close-quarters situation with it.
 fn resume_clear(
     params: &GuidanceParams,
     tow: &TowState,
     vessels: &[(TowVessel, [f64; 2], f64); 3],
     obstacle: &ActiveObstacle,
-    resume_speed: Option<f64>,
+    leg: Option<[[f64; 2]; 3]>,
 ) -> bool {
-    match (obstacle, resume_speed) {
-        (ActiveObstacle::Vessel(target), Some(speed)) => {
-            let (sin, cos) = tow.ship.psi.sin_cos();
-            let v_own = [speed * cos, speed * sin];
-            clearance_margin(params, vessels, target, [0.0; 2], v_own) >= 0.0
-        }
-        _ => true,
-    }
+    let ActiveObstacle::Vessel(target) = obstacle else {
+        return true;
+    };
+    let course = leg
+        .map(|[from, to, _]| (to[1] - from[1]).atan2(to[0] - from[0]))
+        .unwrap_or(tow.ship.psi);
+    let (sin, cos) = course.sin_cos();
+    let speed = params.settings().resume_speed;
+    clearance_margin(
+        params,
+        vessels,
+        target,
+        [0.0; 2],
+        [speed * cos, speed * sin],
+    ) >= 0.0
 }
 
 /// The smallest margin (m) over the vessels of the tow between the range-equivalent
@@ -549,8 +562,6 @@ struct Encounters {
     latched: u64,
     /// A target for which the tow has taken the way off (Rule 17).
     way_off: u64,
-    /// With the way off: the ship's speed along her heading when she took it off.
-    resume_speed: [f64; MAX_OBSTACLES],
     /// Found past and clear, the encounter not yet over.
     cleared: u64,
     /// Crossed the ship's heading line ahead of her by its own motion.
@@ -573,7 +584,6 @@ impl Encounters {
         Self {
             latched: 0,
             way_off: 0,
-            resume_speed: [0.0; MAX_OBSTACLES],
             cleared: 0,
             crossed: 0,
             past: 0,
@@ -725,7 +735,7 @@ impl ReferenceSystem {
         next: &mut Encounters,
         a: &ObstacleAssessment,
         context: &AssessContext,
-        (sighting, tow): (Sighting, &TowState),
+        sighting: Sighting,
     ) -> bool {
         let s = self.params.settings();
         let bit = 1u64 << a.index;
@@ -739,21 +749,24 @@ impl ReferenceSystem {
         if a.past_and_clear {
             next.past |= bit;
         }
-        // Rule 8(d): the way stays off until the target is past and clear (it has
-        // crossed ahead of the slowed tow by its own motion and the range is opening
-        // and safe from every vessel) and the tow resuming at her former speed would
-        // pass it clear (else she would turn away from it or run up on it), or until
-        // it has left the encounter distance and is no longer closing.
+        // Rule 8(d): an action (the alteration or the way off) is held until the target
+        // is finally past and clear: past and clear (it has crossed ahead of the ship by
+        // its own motion, or is abaft her beam, and the range is opening and safe from
+        // every vessel) and the tow resuming her route would pass it clear (else she
+        // would turn or run back into a close-quarters situation with it); or until the
+        // target has left: beyond the encounter distance, no longer closing, and clear
+        // of the resumed track. A range opened by the tow's own braking or turning
+        // releases nothing while her resumed track would bring her back to it.
         let closing = a.encounter.is_some_and(|e| e.cpa.is_closing());
         let finally_clear = a.past_and_clear && a.resume_clear;
-        let keeps_way_off = slowed && !finally_clear && (near || closing);
-        if a.manoeuvre == Manoeuvre::TakeWayOff || keeps_way_off {
+        let left = !near && !closing && a.resume_clear;
+        let holds = context.acting && !finally_clear && !left;
+        if a.manoeuvre == Manoeuvre::TakeWayOff || (slowed && holds) {
             next.way_off |= bit;
-            next.resume_speed[a.index] = context.resume_speed.unwrap_or_else(|| tow.speed_ahead());
         }
-        // A way-off taken under Rule 17 (judged by the CPA, possibly beyond d_D) keeps
-        // the encounter open, up to the sample that releases it.
-        let in_encounter = near || slowed || next.way_off & bit != 0;
+        // An action taken under Rule 17 (judged by the CPA, possibly beyond d_D) or held
+        // beyond d_D keeps the encounter open, up to the sample that releases it.
+        let in_encounter = near || holds || next.way_off & bit != 0;
         // The way-off is the tow's action and lets the target pass ahead: the
         // MPC's distance cost leaves the target out as for a stand-on target (its
         // clearance rows stay), so the tugs do not swing the tow's head after it; so
@@ -779,15 +792,11 @@ impl ReferenceSystem {
         // An encounter found past and clear stays over until it ends (or a new
         // close-quarters situation arises, in `assess_obstacle`): the tow's own
         // return to the route must not turn an opening range into a new encounter.
-        let acted = (self.encounters.latched | self.encounters.way_off) & bit != 0;
-        if in_encounter && a.past_and_clear && (context.cleared || acted) {
+        if in_encounter && a.past_and_clear && (context.cleared || context.acting) {
             next.cleared |= bit;
         }
         let demands = a.manoeuvre == Manoeuvre::AlterToStarboard;
-        let keeps = self.encounters.latched & bit != 0
-            && in_encounter
-            && a.alteration_allowed
-            && !a.past_and_clear;
+        let keeps = self.encounters.latched & bit != 0 && a.alteration_allowed && holds;
         if demands || keeps {
             next.latched |= bit;
         }
@@ -838,8 +847,7 @@ impl ReferenceSystem {
                 previous: self.encounters.sightings[index],
                 crossed: self.encounters.crossed & bit != 0,
                 way_off: self.encounters.way_off & bit != 0,
-                resume_speed: (self.encounters.way_off & bit != 0)
-                    .then_some(self.encounters.resume_speed[index]),
+                acting: (self.encounters.latched | self.encounters.way_off) & bit != 0,
             };
             let a = assess_obstacle(&self.params, tow, index, &obstacle, &context);
             if a.range < d_ob {
@@ -850,7 +858,7 @@ impl ReferenceSystem {
                 ship: tow.ship,
                 target: obstacle.centre(),
             };
-            let keeps_altered = self.track(&mut next, &a, &context, (sighting, tow));
+            let keeps_altered = self.track(&mut next, &a, &context, sighting);
             if keeps_altered && nearest_latched.is_none_or(|n| a.range < n.range) {
                 nearest_latched = Some(a);
             }
@@ -1026,17 +1034,26 @@ mod tests {
         let tow = tow_at(Pose::new(2.0, 0.0, 0.0), 0.1);
         let tug2 = tow.tug2.x;
         let at = |ahead: f64| [vessel(tug2 + ahead, 0.0, PI, 0.07)];
+        // The same target turned away, running from the tow faster than she goes.
+        let away = |ahead: f64| [vessel(tug2 + ahead, 0.0, 0.0, 0.2)];
         assert!(rs.update(&tow, &at(6.0)).unwrap().altered);
-        // The target, still closing, now 7.3 m ahead: outside d_D but inside
-        // d_D + 0.5 m, still altered (the encounter is not over).
-        let out = rs.update(&tow, &at(7.3)).unwrap();
+        // Still closing, now 7.6 m ahead, beyond d_D + 0.5 m: the resumed track would
+        // run into it, so the alteration is held (Rule 8(d), finally past and clear).
+        let out = rs.update(&tow, &at(7.6)).unwrap();
+        let g = out.governing.unwrap();
+        assert!(!g.detected && !g.past_and_clear && !g.resume_clear);
+        assert!(out.altered);
+        // Running away, 7.3 m ahead: outside d_D but inside d_D + 0.5 m, still
+        // altered (the encounter is not over).
+        let out = rs.update(&tow, &away(7.3)).unwrap();
         let g = out.governing.unwrap();
         assert_eq!(g.situation, Some(Situation::HeadOn));
-        assert!(!g.detected && !g.past_and_clear);
+        assert!(!g.detected && !g.past_and_clear && g.resume_clear);
         assert!(out.altered);
         assert!(out.eta_sd.y > 0.0);
-        // 7.6 m > 7.5 m: over, back to the predefined waypoint.
-        let out = rs.update(&tow, &at(7.6)).unwrap();
+        // 7.6 m > 7.5 m, not closing, clear of the resumed track: over, back to the
+        // predefined waypoint.
+        let out = rs.update(&tow, &away(7.6)).unwrap();
         assert!(!out.altered);
         assert_eq!(out.theta, 0.0);
         assert_eq!(out.eta_sd, Pose::new(30.0, 0.0, 0.0));
@@ -1082,6 +1099,56 @@ mod tests {
     /// north-east) but which has not crossed ahead: not past (the old test, an
     /// opening range beyond the safe range, released it). Once it has crossed the
     /// ship's heading line ahead of her, westbound, it is past and clear.
+    #[test]
+    fn a_give_way_alteration_is_held_while_the_resumed_track_would_run_up_on_the_target() {
+        // A target converging slowly from starboard, nearly on the tow's course
+        // (relative course -25 deg) and slower than she goes: it crosses ahead of the
+        // tow, which has slowed and turned away, but resuming the route would run up on
+        // it again. The range opened by the tow's own braking ends nothing.
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let mut target = vessel(4.4, 4.57, deg(-25.0), 0.06);
+        let mut ship = Pose::new(0.0, 0.0, 0.0);
+        for _ in 0..40 {
+            let out = rs.update(&tow_at(ship, 0.1), &[target]).unwrap();
+            assert!(out.altered);
+            assert_eq!(
+                out.governing.unwrap().situation,
+                Some(Situation::CrossingGiveWay)
+            );
+            ship.x += 0.1;
+            target = moved(target, 1.0);
+        }
+        // The tow, turned 15 deg to starboard, has taken the way off; the target goes on.
+        let stopped = tow_at(
+            Pose {
+                psi: deg(15.0),
+                ..ship
+            },
+            0.0,
+        );
+        // Past and clear by the old test (crossed ahead, range opening and safe) but not
+        // clear of the resumed track: held; released once the resumed track clears it.
+        let (mut held, mut released) = (0, None);
+        for k in 1..=600 {
+            target = moved(target, 1.0);
+            let out = rs.update(&stopped, &[target]).unwrap();
+            let g = out.governing.unwrap();
+            if g.past_and_clear && !g.resume_clear {
+                assert!(
+                    out.altered,
+                    "released at {k} s with the resumed track not clear"
+                );
+                held += 1;
+            }
+            if !out.altered && released.is_none() {
+                released = Some(g);
+            }
+        }
+        assert!(held >= 10, "held {held} s past the old release");
+        let g = released.expect("released once the resumed track passes clear");
+        assert!(g.past_and_clear && g.resume_clear);
+    }
+
     #[test]
     fn a_crossing_target_is_past_only_once_it_has_crossed_ahead_by_its_own_motion() {
         let tow = tow_at(Pose::new(0.0, 0.0, 0.0), 0.0);

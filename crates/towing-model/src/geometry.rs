@@ -35,16 +35,36 @@ pub fn line_coordinates(origin: Point, course: f64, p: Point) -> (f64, f64) {
     (dn * c + de * s, -dn * s + de * c)
 }
 
+/// Own ship's heading line and a target at one sample: own position, own heading (rad from
+/// North, clockwise), the target's position.
+pub type LineSighting = (Point, f64, Point);
+
 /// COLREGS Rule 8(d), a crossing target *past*: between two samples the target went from
-/// `before` to `now` across the heading line of own ship's pose `(origin, course)` at the
-/// earlier sample, held still over the step (so neither own ship's turn nor its sideways
-/// motion can make the crossing), and lies ahead of that pose. The one test of the
-/// guidance (`towing_guidance::Sighting`) and of the analyzer's Rule 8 check.
+/// one side of own ship's heading line to the other (each sample's line through that
+/// sample's pose), lies ahead of her, and its own motion made the crossing: its
+/// displacement across the earlier sample's line, held still, is in the crossing's
+/// direction and at least half of the change of its side. The rest of the change is own
+/// ship's turn and sideways motion, which alone never make a crossing (a tow turning away
+/// from a target sweeps her heading line across it). The share is a ratio of rates, so
+/// the verdict does not depend on where the samples fall: with the target and the line
+/// closing on each other at similar rates, whether the target crosses the earlier line
+/// held still within one step depends on the sampling phase (an analyzer at 0.1 s and a
+/// controller at 1 s disagreed on random-12-0062). The one test of the guidance
+/// (`towing_guidance::Sighting`) and of the analyzer's Rule 8 check.
 #[must_use]
-pub fn crossed_ahead(origin: Point, course: f64, before: Point, now: Point) -> bool {
-    let (_, side_before) = line_coordinates(origin, course, before);
-    let (along, side_now) = line_coordinates(origin, course, now);
-    side_before != 0.0 && side_before * side_now <= 0.0 && along > 0.0
+pub fn crossed_ahead(before: LineSighting, now: LineSighting) -> bool {
+    let (origin0, course0, target0) = before;
+    let (origin1, course1, target1) = now;
+    let (_, side0) = line_coordinates(origin0, course0, target0);
+    let (along, side1) = line_coordinates(origin1, course1, target1);
+    let (_, own) = line_coordinates(origin0, course0, target1);
+    let own_change = own - side0;
+    let change = side1 - side0;
+    side0 != 0.0
+        && side0 * side1 <= 0.0
+        && along > 0.0
+        && own_change * change > 0.0
+        && own_change.abs() >= 0.5 * change.abs()
 }
 
 /// Body point `(bx forward, by starboard)` of a vessel at `(x, y, psi)`, in NED
@@ -226,6 +246,57 @@ impl Polyline {
         best
     }
 
+    /// The point at arc length `s` along the polyline (clamped to `[0, length]`).
+    #[must_use]
+    pub fn point_at(&self, s: f64) -> Point {
+        let s = s.clamp(0.0, self.length());
+        let k = self
+            .cum
+            .partition_point(|&c| c < s)
+            .clamp(1, self.points.len().max(2) - 1);
+        match (self.points.get(k - 1), self.points.get(k)) {
+            (Some(a), Some(b)) => {
+                let span = self.cum[k] - self.cum[k - 1];
+                let f = if span > 0.0 {
+                    (s - self.cum[k - 1]) / span
+                } else {
+                    0.0
+                };
+                [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])]
+            }
+            _ => self.points[0],
+        }
+    }
+
+    /// The course (rad from North, clockwise) of the manoeuvre of following the
+    /// polyline, seen from `p`: the bearing from `p`'s nearest point on it to the point
+    /// `lookahead` m farther along it, so a bend turns it over the `lookahead` before
+    /// the bend; at the end, the last segment's course. `None` for a polyline without
+    /// length. COLREGS Rule 17's "course" is this one, not the compass heading at the
+    /// sighting (Windsor-Roanoke, 1908: "course and speed in following the nautical
+    /// manoeuvre in which ... the vessel is at the time engaged"; Cockcroft and
+    /// Lameijer, *A Guide to the Collision Avoidance Rules*, on Rule 17).
+    #[must_use]
+    pub fn course_ahead(&self, p: Point, lookahead: f64) -> Option<f64> {
+        let length = self.length();
+        if length.is_nan() || length <= 0.0 {
+            return None;
+        }
+        let here = self.project(p).s;
+        let (from, to) = if here + 1e-9 < length {
+            (
+                self.point_at(here),
+                self.point_at(here + lookahead.max(1e-6)),
+            )
+        } else {
+            // At the end: the last segment of non-zero length.
+            let last = self.cum.partition_point(|&c| c < length).max(1);
+            (self.points[last - 1], self.end())
+        };
+        let (dn, de) = (to[0] - from[0], to[1] - from[1]);
+        (dn != 0.0 || de != 0.0).then(|| de.atan2(dn))
+    }
+
     /// Distance of `p` from the polyline (nearest point of any segment), m.
     #[must_use]
     pub fn distance(&self, p: Point) -> f64 {
@@ -323,6 +394,56 @@ impl Lane {
 mod tests {
     use super::*;
     use std::f64::consts::PI;
+
+    /// Steps a target 8 m ahead of a ship heading North: the target moves West at
+    /// `target_rate` (m/s) from `east0` m East, the ship's heading turns East at a
+    /// rate that sweeps her line West across the target at `line_rate` (m/s) there,
+    /// sampled every `dt` s; true when a crossing is found.
+    fn crossing_found(east0: f64, target_rate: f64, line_rate: f64, dt: f64) -> bool {
+        let at = |t: f64| {
+            let psi = (line_rate * t / 8.0).atan();
+            ([0.0, 0.0], psi, [8.0, east0 - target_rate * t])
+        };
+        let steps = (60.0 / dt).round() as usize;
+        (1..=steps).any(|k| crossed_ahead(at((k - 1) as f64 * dt), at(k as f64 * dt)))
+    }
+
+    #[test]
+    fn the_course_ahead_turns_over_the_lookahead_before_a_bend() {
+        let route = Polyline::new(vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]]).unwrap();
+        let deg = |p: Point, l: f64| route.course_ahead(p, l).unwrap().to_degrees();
+        assert!(deg([2.0, 0.0], 3.0).abs() < 1e-9);
+        // Off the route, the course is still the route's.
+        assert!(deg([2.0, 3.0], 3.0).abs() < 1e-9);
+        // 1 m before the bend: towards the point 2 m into the next leg.
+        assert!((deg([9.0, 0.0], 3.0) - 2f64.atan2(1.0).to_degrees()).abs() < 1e-9);
+        assert!((deg([10.0, 5.0], 3.0) - 90.0).abs() < 1e-9);
+        // At and beyond the end: the last leg's course.
+        assert!((deg([10.0, 10.0], 3.0) - 90.0).abs() < 1e-9);
+        assert!((deg([10.0, 12.0], 3.0) - 90.0).abs() < 1e-9);
+        assert_eq!(route.point_at(15.0), [10.0, 5.0]);
+        assert!(Polyline::new(vec![[1.0, 1.0]])
+            .unwrap()
+            .course_ahead([0.0, 0.0], 3.0)
+            .is_none());
+    }
+
+    #[test]
+    fn a_crossing_is_the_targets_own_whatever_the_step_and_its_phase() {
+        for dt in [0.1, 0.5, 1.0] {
+            for east0 in [0.3, 0.3137, 0.35, 0.377] {
+                // Target alone, or faster across than the line: crossed.
+                assert!(crossing_found(east0, 0.05, 0.0, dt), "{dt} {east0}");
+                assert!(crossing_found(east0, 0.03, 0.02, dt), "{dt} {east0}");
+                // The line swept across a still or slower target: not crossed.
+                assert!(!crossing_found(east0, 0.0, 0.05, dt), "{dt} {east0}");
+                assert!(!crossing_found(east0, 0.02, 0.03, dt), "{dt} {east0}");
+            }
+        }
+        // Behind the ship: never.
+        let astern = |t: f64| ([0.0, 0.0], 0.0, [-8.0, 0.3 - 0.05 * t]);
+        assert!(!(1..=60).any(|k| crossed_ahead(astern(f64::from(k - 1)), astern(f64::from(k)))));
+    }
 
     fn l_lane() -> Lane {
         Lane::new(
