@@ -349,9 +349,6 @@ impl Target {
         (range, beta, turn): (f64, f64, f64),
         th: &Thresholds,
     ) {
-        if self.det.is_none() {
-            return;
-        }
         let turned = turn >= th.give_way_turn_deg;
         let way_off = ship.u <= th.way_off_surge_m_s;
         let acting = turned || way_off;
