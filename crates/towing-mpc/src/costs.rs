@@ -469,10 +469,12 @@ fn terminal_terms<const N: usize>(
 /// swung to port while giving way (scheme I) (`docs/controller-design.md`).
 /// A move-suppression term is the standard remedy (Maciejowski 2002, Predictive
 /// Control with Constraints, section 3.1, the weight on input changes). The
-/// distributed controller does not need it (the ADMM's penalty `rho` keeps
-/// the consensus soft within an iteration, and no such alternation was seen),
-/// and there it slowed the ADMM's convergence on the paper instance tenfold,
-/// so it is not in the tug problem: with `w > 0` the two architectures solve
+/// distributed controller does without it (the ADMM's penalty `rho` keeps
+/// the consensus soft within an iteration; the alternation shows there only in a
+/// transient while a towing angle swings at its rate limit), and there it slowed
+/// the ADMM's convergence on the paper instance tenfold and, tried again, made
+/// the encounter suites worse (`docs/controller-design.md`), so it is not in the
+/// tug problem: with `w > 0` the two architectures solve
 /// problems that differ by this term (`distributed_matches_centralized` sets it
 /// to 0).
 pub(crate) fn thrust_rate_terms<const N: usize>(
