@@ -4,7 +4,9 @@
 //! crate's model description binary, committed under `modelDescription/`, and packaged from
 //! there; packaging refuses to run when the committed file differs from the generated one.
 
-use crate::{build_release, fail, output, progress, root, target_dir, FmuCrate, Result, FMUS};
+use crate::{
+    build_release, fail, output, progress, root, target_dir, Build, FmuCrate, Result, FMUS,
+};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -44,7 +46,7 @@ pub fn write_model_descriptions() -> Result<()> {
     let doc_path = root().join("docs/interface.md");
     let mut doc = std::fs::read_to_string(&doc_path)
         .or_else(|e| fail(STEP, format!("{}: {e}", doc_path.display())))?;
-    build_release()?;
+    build_release(Build::Products)?;
     for fmu in FMUS {
         let generated = generate(fmu)?;
         let path = committed_path(fmu);
@@ -87,7 +89,7 @@ fn splice(doc: &str, id: &str, what: &str, table: &str) -> std::result::Result<S
 /// `cargo xtask fmu`: builds and packages every FMU; returns the paths of the .fmu files.
 pub fn package_all() -> Result<Vec<PathBuf>> {
     let mut packages = Vec::new();
-    build_release()?;
+    build_release(Build::Products)?;
     for fmu in FMUS {
         packages.push(package(fmu)?);
     }

@@ -156,15 +156,36 @@ pub fn cargo() -> Command {
     Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
 }
 
-/// The one release build every command uses: the whole workspace, every target. One package
-/// selection means one resolved feature set (cargo unifies features over the selected
-/// packages and, once a test, bench or example is built, their dev-dependencies), so the
-/// demo, the FMU packaging, the campaigns and `cargo test --workspace --release` share every
-/// compiled dependency, polars above all, instead of compiling it once per selection.
-pub fn build_release() -> Result<()> {
+/// What a release build compiles. Both select the whole workspace, and cargo resolves the
+/// same features for polars and every other dependency of the analyzer either way (the
+/// dev-dependencies only add `towing-interface`'s `testing` helpers, so just that crate and
+/// the two FMU crates compile a second time), so the demo, the FMU packaging, the campaigns,
+/// `cargo test --workspace --release` and the baseline share every compiled dependency,
+/// polars above all, instead of compiling it once per selection.
+#[derive(Debug, Clone, Copy)]
+pub enum Build {
+    /// Libraries and binaries: the FMUs, the analyzer, the fuzz commands, the model
+    /// description printers. What the demo, the packaging and the campaigns run; a cold
+    /// demo does not wait for the tests and benches.
+    Products,
+    /// Also every test, bench and example (the baseline's recorder is an example).
+    AllTargets,
+}
+
+/// The release build of `what` (see [`Build`]).
+pub fn build_release(what: Build) -> Result<()> {
+    let (step, selection): (&str, &[&str]) = match what {
+        Build::Products => (
+            "release build (workspace, libraries and binaries)",
+            &["--lib", "--bins"],
+        ),
+        Build::AllTargets => ("release build (workspace, all targets)", &["--all-targets"]),
+    };
     run(
-        "release build (workspace, all targets)",
-        cargo().args(["build", "--release", "--workspace", "--all-targets"]),
+        step,
+        cargo()
+            .args(["build", "--release", "--workspace"])
+            .args(selection),
     )
 }
 

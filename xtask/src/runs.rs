@@ -78,10 +78,18 @@ pub struct Tools {
 
 impl Tools {
     /// Prepares all of them (a second call reuses what exists: the venv's stamp, cargo's
-    /// incremental build).
+    /// incremental build). The venv is set up while cargo builds (pip waits on the network,
+    /// the build on the CPU: on a fresh machine this hides the half minute pip takes).
     pub fn prepare() -> Result<Self> {
-        let python = python::ensure_env()?;
-        let fmus = fmu::package_all()?;
+        let venv = std::thread::spawn(python::ensure_env);
+        let fmus = fmu::package_all();
+        let python = venv.join().unwrap_or_else(|_| {
+            fail(
+                "set up the Python environment",
+                "the set-up thread panicked",
+            )
+        })?;
+        let fmus = fmus?;
         let find = |model: &str| {
             fmus.iter()
                 .find(|p| p.file_stem().is_some_and(|n| n == model))
