@@ -83,13 +83,9 @@ impl Tools {
     pub fn prepare() -> Result<Self> {
         let venv = std::thread::spawn(python::ensure_env);
         let fmus = fmu::package_all();
-        let python = venv.join().unwrap_or_else(|_| {
-            fail(
-                "set up the Python environment",
-                "the set-up thread panicked",
-            )
-        })?;
+        let python = crate::join_venv(venv);
         let fmus = fmus?;
+        let python = python?;
         let find = |model: &str| {
             fmus.iter()
                 .find(|p| p.file_stem().is_some_and(|n| n == model))
