@@ -67,8 +67,8 @@ fn parse(args: &[String]) -> Result<Options> {
 /// The command (module docs).
 pub fn bench_baseline(args: &[String]) -> Result<()> {
     let o = parse(args)?;
-    let python = python::ensure_env()?;
-    crate::build_release(crate::Build::AllTargets)?;
+    let (python, ()) =
+        python::ensure_env_during(|| crate::build_release(crate::Build::AllTargets))?;
     let recorder = target_dir().join("release/examples/record_centralized");
     let script = root().join("benches/baseline/casadi_centralized.py");
     let dir = &o.out;

@@ -243,29 +243,15 @@ fn main() -> ExitCode {
 }
 
 /// The README's test command: formatting, lints, packaging, Rust tests, Python tests. The
-/// venv is set up while cargo works (see `runs::Tools::prepare`).
+/// venv is set up while cargo works ([`python::ensure_env_during`]).
 fn test_all() -> Result<()> {
-    let venv = std::thread::spawn(python::ensure_env);
-    let rust = rust_checks();
-    let python = join_venv(venv);
-    rust?;
-    let python = python?;
+    let (python, ()) = python::ensure_env_during(rust_checks)?;
     run(
         "python tests",
         Command::new(&python).args(["-m", "pytest", "tests/python", "-q", "-ra"]),
     )?;
     progress("all checks passed");
     Ok(())
-}
-
-/// The venv of a set-up thread (`std::thread::spawn(python::ensure_env)`).
-pub fn join_venv(venv: std::thread::JoinHandle<Result<PathBuf>>) -> Result<PathBuf> {
-    venv.join().unwrap_or_else(|_| {
-        fail(
-            "set up the Python environment",
-            "the set-up thread panicked",
-        )
-    })
 }
 
 /// Formatting, lints, packaging and the Rust tests of [`test_all`].

@@ -7,6 +7,22 @@ use crate::{fail, progress, root, run, Result};
 use std::path::PathBuf;
 use std::process::Command;
 
+/// Runs `work` while [`ensure_env`] sets the venv up in a thread (pip waits on the network,
+/// cargo on the CPU: on a fresh machine this hides the half minute pip takes); returns the
+/// venv's python and `work`'s result. When both fail, `work`'s error is the one reported.
+pub fn ensure_env_during<T>(work: impl FnOnce() -> Result<T>) -> Result<(PathBuf, T)> {
+    let venv = std::thread::spawn(ensure_env);
+    let done = work();
+    let python = venv.join().unwrap_or_else(|_| {
+        fail(
+            "set up the Python environment",
+            "the set-up thread panicked",
+        )
+    });
+    let done = done?;
+    Ok((python?, done))
+}
+
 /// Ensures `.venv` exists with the pinned requirements; returns the venv's python.
 pub fn ensure_env() -> Result<PathBuf> {
     const STEP: &str = "python environment";

@@ -78,14 +78,9 @@ pub struct Tools {
 
 impl Tools {
     /// Prepares all of them (a second call reuses what exists: the venv's stamp, cargo's
-    /// incremental build). The venv is set up while cargo builds (pip waits on the network,
-    /// the build on the CPU: on a fresh machine this hides the half minute pip takes).
+    /// incremental build). The venv is set up while cargo builds.
     pub fn prepare() -> Result<Self> {
-        let venv = std::thread::spawn(python::ensure_env);
-        let fmus = fmu::package_all();
-        let python = crate::join_venv(venv);
-        let fmus = fmus?;
-        let python = python?;
+        let (python, fmus) = python::ensure_env_during(fmu::package_all)?;
         let find = |model: &str| {
             fmus.iter()
                 .find(|p| p.file_stem().is_some_and(|n| n == model))
