@@ -39,7 +39,10 @@
 //!    limits).
 //! 4. While any obstacle keeps it, the reference is the active waypoint rotated to
 //!    starboard about the previous predefined waypoint (eq. (10)-(11)); otherwise the
-//!    predefined waypoint (eq. (8), `eta_Sd = eta_Sp`).
+//!    predefined waypoint (eq. (8), `eta_Sd = eta_Sp`). An alteration whose encounters
+//!    have all ended is held while the tow stands on for a target within its detection
+//!    distance that is not yet past and clear (Rule 17(a)(i), 17(c): the return to the
+//!    route would be a course change to port; [`keeps_course`]).
 //! 5. The active waypoint advances when the ship reaches the reference waypoint
 //!    (acceptance radius) or has passed it; the destination is held.
 
@@ -490,6 +493,24 @@ fn stands_on(params: &GuidanceParams, a: &ObstacleAssessment) -> bool {
         && a.encounter.is_some_and(|e| !acts(&e.cpa))
 }
 
+/// Whether this assessment's target asks the tow to keep her present course: a target
+/// ship within its detection distance for which the tow stands on (crossing stand-on,
+/// being overtaken: Rule 17(a)(i), course and speed kept) and which is not past and
+/// clear. An alteration in force when its own encounters end is then held, not undone:
+/// the return to the route is a course change, to port after a starboard alteration,
+/// and Rule 17(c) forbids a port turn for a vessel on the own port side (the stand-on
+/// crossing target is always there) while 17(a)(i) asks the stand-on vessel to keep her
+/// course whichever side the target is on (`docs/colregs.md`, "Course kept while standing
+/// on").
+fn keeps_course(a: &ObstacleAssessment) -> bool {
+    a.detected
+        && !a.past_and_clear
+        && matches!(
+            a.situation,
+            Some(Situation::CrossingStandOn | Situation::BeingOvertaken)
+        )
+}
+
 /// Output of one sample.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct GuidanceOutput {
@@ -511,7 +532,9 @@ pub struct GuidanceOutput {
     /// active obstacle (eq. (8)); `+inf` without obstacles.
     pub d_ob: f64,
     /// The governing obstacle: while altered, the nearest of those keeping the
-    /// alteration; otherwise the nearest obstacle (the one giving `d_ob`).
+    /// alteration (none while it is only held for a target the tow stands on: no
+    /// encounter asks for the action any more); otherwise the nearest obstacle (the one
+    /// giving `d_ob`).
     pub governing: Option<ObstacleAssessment>,
 }
 
@@ -560,6 +583,11 @@ pub struct ReferenceSystem {
 struct Encounters {
     /// Keeping the route altered.
     latched: u64,
+    /// The route stays altered after every encounter that altered it has ended, because
+    /// the tow stands on for a target that is not yet past and clear
+    /// ([`keeps_course`]): the return to the route would be a course change (a port
+    /// turn) that Rule 17(a)(i) and 17(c) forbid.
+    course_held: bool,
     /// A target for which the tow has taken the way off (Rule 17).
     way_off: u64,
     /// Found past and clear, the encounter not yet over.
@@ -583,6 +611,7 @@ impl Encounters {
     fn new() -> Self {
         Self {
             latched: 0,
+            course_held: false,
             way_off: 0,
             cleared: 0,
             crossed: 0,
@@ -682,10 +711,11 @@ impl ReferenceSystem {
         slot < MAX_OBSTACLES && self.encounters.standing_on & (1 << slot) != 0
     }
 
-    /// True while an encounter keeps the route altered.
+    /// True while an encounter keeps the route altered, or the alteration is held for a
+    /// target the tow stands on ([`GuidanceOutput::altered`]).
     #[must_use]
     pub fn is_altered(&self) -> bool {
-        self.encounters.latched != 0
+        self.encounters.latched != 0 || self.encounters.course_held
     }
 
     /// Altering angle of segment `p`: `theta`, bounded by `theta_max` (remark on
@@ -826,6 +856,7 @@ impl ReferenceSystem {
         let mut nearest: Option<ObstacleAssessment> = None;
         let mut next = Encounters::new();
         let mut nearest_latched: Option<ObstacleAssessment> = None;
+        let mut course_kept = false;
         let points = self.route.points();
         let leg = [
             points[self.active - 1].position(),
@@ -858,12 +889,15 @@ impl ReferenceSystem {
                 ship: tow.ship,
                 target: obstacle.centre(),
             };
+            course_kept |= keeps_course(&a);
             let keeps_altered = self.track(&mut next, &a, &context, sighting);
             if keeps_altered && nearest_latched.is_none_or(|n| a.range < n.range) {
                 nearest_latched = Some(a);
             }
         }
-        let altered = next.latched != 0;
+        let was_altered = self.encounters.latched != 0 || self.encounters.course_held;
+        next.course_held = next.latched == 0 && was_altered && course_kept;
+        let altered = next.latched != 0 || next.course_held;
         let way_off = next.way_off;
         self.encounters = next;
 
@@ -1092,6 +1126,41 @@ mod tests {
         let overtaking = [vessel(tow.tug1.x - 3.0, 0.0, 0.0, 0.3)];
         let g = rs.update(&tow, &overtaking).unwrap().governing.unwrap();
         assert!(!g.past_and_clear);
+    }
+
+    #[test]
+    fn an_alteration_is_held_while_the_tow_stands_on_for_another_target() {
+        // The head-on target's encounter ends as in the test above, but a target
+        // overtaking the tow from astern is within d_D and not past: the tow stands on
+        // for it (Rule 17(a)(i)), so the return to the route, a turn to port, waits.
+        let tow = tow_at(Pose::new(2.0, 0.0, 0.0), 0.1);
+        let ahead = vessel(tow.tug2.x + 6.0, 0.0, PI, 0.07);
+        let past = vessel(tow.tug1.x - 3.0, 0.0, PI, 0.07);
+        let overtaking = vessel(tow.tug1.x - 4.0, 0.8, 0.0, 0.3);
+        let none = ObstacleSlot::default();
+        // On its own, the overtaking target alters nothing: the tow stands on.
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let out = rs.update(&tow, &[none, overtaking]).unwrap();
+        assert!(!out.altered);
+        assert_eq!(rs.situation(1), Some(Situation::BeingOvertaken));
+        assert!(rs.stands_on(1));
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        assert!(rs.update(&tow, &[ahead, none]).unwrap().altered);
+        let altered = rs.update(&tow, &[ahead, none]).unwrap().eta_sd;
+        // The head-on target past and clear, the overtaking one coming up: held, on the
+        // same altered waypoint.
+        let out = rs.update(&tow, &[past, overtaking]).unwrap();
+        assert!(out.governing.is_none(), "no encounter asks for the action");
+        assert!(rs.past_and_clear(0) && !rs.past_and_clear(1));
+        assert!(out.altered && rs.is_altered());
+        assert_eq!(out.eta_sd, altered);
+        assert!(rs.update(&tow, &[past, overtaking]).unwrap().altered);
+        // Once nothing asks the tow to keep her course, she returns to the route.
+        let out = rs.update(&tow, &[past, none]).unwrap();
+        assert!(!out.altered && !rs.is_altered());
+        assert_eq!(out.eta_sd, Pose::new(30.0, 0.0, 0.0));
+        // And an alteration released is not taken again by a stand-on target alone.
+        assert!(!rs.update(&tow, &[none, overtaking]).unwrap().altered);
     }
 
     /// A give-way tow with the way off (at rest, heading North) and a crossing target
