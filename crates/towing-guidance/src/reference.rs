@@ -159,6 +159,11 @@ pub struct ObstacleAssessment {
     /// [`AssessContext::acting`]): the tow resuming her route would pass it clear of
     /// every vessel ([`resume_clear`]). True otherwise.
     pub resume_clear: bool,
+    /// A target ship the tow gives way to in a crossing, with the alteration held for
+    /// it, whose track passes every vessel of the tow clear as she moves now (her
+    /// velocity over ground; at rest once she has taken the way off):
+    /// [`clearance_margin`] at least 0. False otherwise.
+    pub passes_clear: bool,
 }
 
 /// What the reference system knows beyond the obstacle and the tow.
@@ -311,6 +316,15 @@ pub fn assess_obstacle(
     };
     let resume_clear =
         !context.acting || resume_clear(params, tow, &vessels, obstacle, context.leg);
+    let passes_clear = match obstacle {
+        ActiveObstacle::Vessel(target) => {
+            context.acting
+                && situation == Some(Situation::CrossingGiveWay)
+                && !past_and_clear
+                && clearance_margin(params, &vessels, target, [0.0; 2], tow.ship_vel_n) >= 0.0
+        }
+        ActiveObstacle::Circle { .. } => false,
+    };
     ObstacleAssessment {
         index,
         kind: obstacle.kind(),
@@ -327,6 +341,7 @@ pub fn assess_obstacle(
         crossed,
         manoeuvre,
         resume_clear,
+        passes_clear,
     }
 }
 
@@ -597,7 +612,8 @@ struct Encounters {
     /// Past and clear at the last sample.
     past: u64,
     /// Left out of the MPC's distance cost: the tow stands on for it (Rule 17 not yet
-    /// allowing action), has taken the way off for it, or it is over.
+    /// allowing action), has taken the way off for it, gives way to it and it passes her
+    /// clear ([`ObstacleAssessment::passes_clear`]), or it is over.
     standing_on: u64,
     /// The situation held for the encounter.
     held: [Option<Situation>; MAX_OBSTACLES],
@@ -705,7 +721,8 @@ impl ReferenceSystem {
     /// point, for [`Action::StandOn`] close quarters:
     /// [`crate::Rule17Settings::close_quarters_tcpa`]), and the route is kept for it;
     /// or the tow has taken the way off for it (its action; the MPC's distance cost
-    /// leaves it out, its clearance rows stay).
+    /// leaves it out, its clearance rows stay); or she gives way to it in a crossing and
+    /// its track passes her clear ([`ObstacleAssessment::passes_clear`]).
     #[must_use]
     pub fn stands_on(&self, slot: usize) -> bool {
         slot < MAX_OBSTACLES && self.encounters.standing_on & (1 << slot) != 0
@@ -807,7 +824,12 @@ impl ReferenceSystem {
             .held
             .is_some_and(|h| matches!(h, Situation::CrossingStandOn | Situation::BeingOvertaken));
         let over = stood_on && a.past_and_clear && a.resume_clear;
-        if in_encounter && (next.way_off & bit != 0 || over || stands_on(&self.params, a)) {
+        // So does a crossing target the tow gives way to once its track passes her clear
+        // as she moves now: the distance cost made the forward tug of a tow stopped for
+        // such a target dodge along its track, dragging the ship's head to port.
+        if in_encounter
+            && (next.way_off & bit != 0 || over || a.passes_clear || stands_on(&self.params, a))
+        {
             next.standing_on |= bit;
         }
         if let (true, Some(situation)) = (in_encounter, a.situation) {
@@ -1161,6 +1183,32 @@ mod tests {
         assert_eq!(out.eta_sd, Pose::new(30.0, 0.0, 0.0));
         // And an alteration released is not taken again by a stand-on target alone.
         assert!(!rs.update(&tow, &[none, overtaking]).unwrap().altered);
+    }
+
+    #[test]
+    fn a_give_way_target_that_passes_the_stopped_tow_clear_leaves_the_distance_cost() {
+        // A crossing target from starboard, westbound, 4 m ahead of tug 2's track line:
+        // the tow alters for it and takes the way off; at rest, the target's track passes
+        // every vessel of the tow clear, so the MPC's distance cost leaves it out (its
+        // clearance rows stay). One aimed at tug 2 stays in the cost.
+        let moving = tow_at(Pose::new(2.0, 0.0, 0.0), 0.1);
+        let stopped = tow_at(moving.ship, 0.0);
+        let ahead = |x: f64| [vessel(moving.tug2.x + x, 4.0, -PI / 2.0, 0.07)];
+        for (x, clear) in [(4.0, true), (0.0, false)] {
+            let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+            let out = rs.update(&moving, &ahead(x)).unwrap();
+            let g = out.governing.unwrap();
+            assert!(out.altered, "{g:?}");
+            assert_eq!(g.situation, Some(Situation::CrossingGiveWay));
+            assert!(
+                !g.passes_clear && !rs.stands_on(0),
+                "not before the action is held"
+            );
+            let out = rs.update(&stopped, &ahead(x)).unwrap();
+            let g = out.governing.unwrap();
+            assert!(out.altered);
+            assert_eq!((g.passes_clear, rs.stands_on(0)), (clear, clear), "x = {x}");
+        }
     }
 
     /// A give-way tow with the way off (at rest, heading North) and a crossing target
