@@ -624,6 +624,12 @@ struct Encounters {
 }
 
 impl Encounters {
+    /// The route is altered: an encounter keeps the alteration, or it is held for a
+    /// target the tow stands on.
+    fn altered(&self) -> bool {
+        self.latched != 0 || self.course_held
+    }
+
     fn new() -> Self {
         Self {
             latched: 0,
@@ -732,7 +738,7 @@ impl ReferenceSystem {
     /// target the tow stands on ([`GuidanceOutput::altered`]).
     #[must_use]
     pub fn is_altered(&self) -> bool {
-        self.encounters.latched != 0 || self.encounters.course_held
+        self.encounters.altered()
     }
 
     /// Altering angle of segment `p`: `theta`, bounded by `theta_max` (remark on
@@ -917,9 +923,8 @@ impl ReferenceSystem {
                 nearest_latched = Some(a);
             }
         }
-        let was_altered = self.encounters.latched != 0 || self.encounters.course_held;
-        next.course_held = next.latched == 0 && was_altered && course_kept;
-        let altered = next.latched != 0 || next.course_held;
+        next.course_held = next.latched == 0 && self.encounters.altered() && course_kept;
+        let altered = next.altered();
         let way_off = next.way_off;
         self.encounters = next;
 
