@@ -326,6 +326,41 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         g.encounter.map(|e| (e.bearing.to_degrees() * 10.0).round() / 10.0));
                 }
             }
+            if std::env::var("MASK").is_ok() {
+                if let Some(i) = controller.last_mpc_input() {
+                    let obs: Vec<String> = i
+                        .obstacles()
+                        .iter()
+                        .enumerate()
+                        .map(|(j, o)| {
+                            let (d, _) = o.distance([m.ship[0], m.ship[1]]);
+                            format!(
+                                "{}{:.1}",
+                                if i.distance_cost_off & (1 << j) != 0 {
+                                    "-"
+                                } else {
+                                    "+"
+                                },
+                                d
+                            )
+                        })
+                        .collect();
+                    let tg: Vec<String> = (0..towing_model::MAX_OBSTACLES)
+                        .filter_map(|k| {
+                            let o = world.obstacle(k);
+                            (o.kind == ObstacleKind::VesselEllipse).then(|| {
+                                let (dx, dy) = (o.x - m.ship[0], o.y - m.ship[1]);
+                                format!(
+                                    "[{k}: r {:.2} b {:.0}]",
+                                    dx.hypot(dy),
+                                    towing_model::wrap_angle(dy.atan2(dx) - m.ship[2]).to_degrees()
+                                )
+                            })
+                        })
+                        .collect();
+                    eprintln!("MASK t {:.1} psi {:.1} u {:.3} ref {:.1} floor {:?} alt {} wo {} obs {} {}", world.time(), m.ship[2].to_degrees(), m.ship[3], r.reference[2].to_degrees(), r.heading_floor.map(|f| (f.to_degrees() * 10.0).round() / 10.0), r.guidance.altered, r.guidance.way_off, obs.join(" "), tg.join(" "));
+                }
+            }
             if let Some(why) = r.fallback {
                 eprintln!("t = {:.1}: fallback: {why}", world.time());
             }

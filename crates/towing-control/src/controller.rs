@@ -689,7 +689,7 @@ impl Controller {
         .into_iter()
         .flatten()
         .reduce(f64::min);
-        let heading_floor = self.heading_floor(m.ship[2]);
+        let heading_floor = self.heading_floor(m);
         let reference = self.reference(
             &m.ship,
             (guidance.active_waypoint, target),
@@ -983,20 +983,30 @@ impl Controller {
     /// the route, and the tugs dragged her sideways (drift 100 deg). Without it the
     /// centralized MPC, trading the heading error against the tugs' distance
     /// terms of (16), let the stopped tow swing 40 deg to port while giving way
-    /// to target A (`docs/controller-design.md`). Scheme III (distance cost
-    /// only, no COLREGS logic) has no floor, as in the paper.
-    fn heading_floor(&mut self, psi: f64) -> Option<f64> {
+    /// to target A (`docs/controller-design.md`).
+    ///
+    /// A target overtaking the tow on her port side binds the floor as well (Rules 13
+    /// and 17(a)(i): she keeps her course, and a port turn is a turn into the
+    /// overtaking vessel's path): without it the tow's aft tug, pushed off the
+    /// target by its distance terms, swung the ship's head up to 15 deg towards
+    /// it at close quarters. Scheme III (distance cost only, no COLREGS logic)
+    /// has no floor, as in the paper.
+    fn heading_floor(&mut self, m: &Measurement) -> Option<f64> {
+        let psi = m.ship[2];
         let alters = self.config.tuning.scheme.alters();
         let mut floor: Option<f64> = None;
         for k in 0..MAX_OBSTACLES {
-            let binding = alters
-                && !self.guidance.past_and_clear(k)
-                && matches!(
-                    self.guidance.situation(k),
-                    Some(
-                        Situation::HeadOn | Situation::CrossingGiveWay | Situation::CrossingStandOn
-                    )
-                );
+            let no_port_turn = match self.guidance.situation(k) {
+                Some(
+                    Situation::HeadOn | Situation::CrossingGiveWay | Situation::CrossingStandOn,
+                ) => true,
+                Some(Situation::BeingOvertaken) => {
+                    let o = &m.obstacles[k];
+                    wrap_angle((o.y - m.ship[1]).atan2(o.x - m.ship[0]) - psi) < 0.0
+                }
+                _ => false,
+            };
+            let binding = alters && !self.guidance.past_and_clear(k) && no_port_turn;
             if !binding {
                 self.carried.port_turn_anchor[k] = None;
                 continue;

@@ -497,6 +497,46 @@ fn a_stand_on_tow_takes_the_way_off_under_rule_17() {
     assert_eq!(c.last_mpc_input().unwrap().max_surge, None);
 }
 
+/// Being overtaken (Rules 13 and 17(a)(i)) the tow keeps her course: with the
+/// overtaking target on her port quarter the heading floor binds (a port turn is a
+/// turn into its path); on her starboard quarter it does not (no floor is a ceiling).
+#[test]
+fn a_target_overtaking_on_the_port_side_sets_a_heading_floor() {
+    let (scenario, mut m) = paper_measurement();
+    let psi = m.ship[2];
+    let margin = ControllerConfig::new(scenario.clone())
+        .tuning
+        .tracking
+        .port_turn_margin;
+    for (side, floor_expected) in [(-1.0, true), (1.0, false)] {
+        // 3 m astern, 1.5 m abeam, on the ship's course and faster than her.
+        let (aft, abeam) = (-3.0, side * 1.5);
+        m.obstacles[3] = ObstacleSlot {
+            x: m.ship[0] + aft * psi.cos() - abeam * psi.sin(),
+            y: m.ship[1] + aft * psi.sin() + abeam * psi.cos(),
+            psi,
+            speed: 0.2,
+            length: 1.48,
+            width: 0.48,
+            kind: ObstacleKind::VesselEllipse,
+        };
+        let mut c = Controller::new(ControllerConfig::new(scenario.clone())).unwrap();
+        let r = c.sample(&m).unwrap();
+        assert_eq!(
+            r.situation[3],
+            Some(Situation::BeingOvertaken),
+            "side {side}"
+        );
+        match r.heading_floor {
+            Some(f) => {
+                assert!(floor_expected, "side {side}: floor {f}");
+                assert!((f - (psi - margin)).abs() < 1e-12, "{f} vs {psi}");
+            }
+            None => assert!(!floor_expected, "side {side}: no floor"),
+        }
+    }
+}
+
 #[test]
 fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
     let (scenario, mut m) = paper_measurement();
