@@ -686,3 +686,31 @@ fn seamanship_a_head_on_target_crossing_the_heading_line_ahead_is_not_past_until
         "past and clear at {t_clear} s, CPA at {t_cpa} s"
     );
 }
+
+#[test]
+fn seamanship_a_crossing_seen_before_detection_counts_at_detection() {
+    // Regression (random-12-0043): a target crossed the stopped tow's heading line 10 m
+    // ahead by its own motion before any vessel of the tow was within 7 m of it; it then
+    // drew away to port, and was never judged crossed, so the give-way action released
+    // after its CPA read as given up. Here the tow stops at 300 s (x = 19.5 m); the
+    // target, west-south-westbound at 0.05 m/s, crosses the route at x = 30 m at 330 s
+    // (8.4 m from tug 2) and comes within 7 m of tug 2 about 34 s later.
+    let crossed_early = Target {
+        name: "crossed early",
+        at_t0: [
+            30.0 + 0.05 * 330.0 * 30f64.to_radians().cos(),
+            0.05 * 330.0 * 0.5,
+        ],
+        course_deg: 210.0,
+        speed: 0.05,
+    };
+    let r = run(600.0, stop_until(2000.0), no_offset, &[crossed_early]);
+    let target = &r.rules.targets[0];
+    let t_detect = target.t_detect_s.expect("detected");
+    assert!(t_detect > 340.0, "{t_detect}");
+    assert_eq!(
+        target.past_and_clear.as_deref(),
+        Some("crossed ahead before detection")
+    );
+    assert_eq!(target.t_past_and_clear_s, Some(t_detect));
+}

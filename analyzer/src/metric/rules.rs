@@ -41,6 +41,9 @@
 //! motion alone makes the crossing, and the verdict does not depend on the step size); in
 //! any situation, it is abaft the ship's
 //! beam with the range opening while the tow makes way (surge > `way_off_surge_m_s`). A
+//! crossing seen before detection counts at detection if the target has kept drawing away
+//! from the heading line since ("crossed ahead before detection": it crossed ahead of the
+//! ship by its own motion before any vessel of the tow was within `d_detect`). A
 //! head-on or overtaking target moves along the tow's track, not across it: its side of the
 //! heading line changes with a wobble of either vessel, so only the second test applies.
 
@@ -180,6 +183,10 @@ struct Target {
     acting: bool,
     /// The ship's position and heading, and the target's position, at the previous step.
     prev_pose: Option<([f64; 2], f64, [f64; 2])>,
+    /// Before detection: the side of the ship's heading line (+ starboard) the target
+    /// crossed to ahead of her by its own motion, while it keeps drawing away from
+    /// that line ([`Target::watch_crossing`]).
+    crossed_before: Option<f64>,
     /// Each vessel's last side (non-zero) of the target's course line.
     prev_cross: [Option<f64>; 3],
 }
@@ -225,6 +232,7 @@ impl Target {
             stbd_max: 0.0,
             acting: false,
             prev_pose: None,
+            crossed_before: None,
             prev_cross: [None; 3],
         }
     }
@@ -261,6 +269,28 @@ impl Target {
                     return;
                 }
             }
+        }
+    }
+
+    /// Before detection, watches for the target crossing the ship's heading line ahead
+    /// of her by its own motion ([`crossed_ahead`], the test [`Target::past_and_clear`]
+    /// uses after detection); the crossing is kept while the target draws away from
+    /// the line (its own velocity across the line points to the side it is on), so
+    /// that a target which crossed before any vessel of the tow came within `d_detect`
+    /// counts as crossed at detection.
+    fn watch_crossing(&mut self, ship: &Vessel, o: &Obstacle) {
+        if self.det.is_some() {
+            return;
+        }
+        let (sp, tp) = ([ship.x, ship.y], [o.x, o.y]);
+        let prev = self.prev_pose.replace((sp, ship.psi, tp));
+        let (_, side) = line_coordinates(sp, ship.psi, tp);
+        let (_, drift) = line_coordinates([0.0, 0.0], ship.psi, course_velocity(o.course, o.speed));
+        if prev.is_some_and(|p| crossed_ahead(p, (sp, ship.psi, tp))) && side != 0.0 {
+            self.crossed_before = Some(side.signum());
+        }
+        if self.crossed_before.is_some_and(|s| side * s <= 0.0 || drift * s <= 0.0) {
+            self.crossed_before = None;
         }
     }
 
@@ -322,8 +352,11 @@ impl Target {
             Some(Situation::HeadOn | Situation::Overtaking | Situation::BeingOvertaken)
         );
         // From one side of the ship's heading line to the other, its own motion at least
-        // half of the change: the tow's turn alone never makes the crossing.
-        let crossed = crossing && prev.is_some_and(|p| crossed_ahead(p, (sp, ship.psi, tp)));
+        // half of the change: the tow's turn alone never makes the crossing. One seen
+        // before detection counts at detection ([`Target::watch_crossing`]).
+        let before = self.crossed_before.take().is_some();
+        let crossed =
+            crossing && (before || prev.is_some_and(|p| crossed_ahead(p, (sp, ship.psi, tp))));
         let beta = relative_bearing(sp, ship.psi, tp);
         let opening = range_rate(sp, ship.vel_n(), tp, course_velocity(o.course, o.speed)) > 0.0;
         let abaft =
@@ -331,7 +364,9 @@ impl Target {
         if crossed || abaft {
             self.r.t_past_and_clear_s = Some(t);
             self.r.past_and_clear = Some(
-                if crossed {
+                if crossed && before {
+                    "crossed ahead before detection"
+                } else if crossed {
                     "crossed ahead"
                 } else {
                     "abaft the beam, opening"
@@ -530,6 +565,7 @@ impl RulesTracker {
             let target = &mut self.targets[k];
             target.present = true;
             target.watch_controller(step);
+            target.watch_crossing(&ship, o);
             target.detect(step.t, (&ship, course), &step.vessels, o, self.d_detect);
             target.observe(step.t, ((&step.vessels, &self.sizes), course), o, &self.th);
         }

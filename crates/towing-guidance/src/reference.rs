@@ -607,7 +607,8 @@ struct Encounters {
     way_off: u64,
     /// Found past and clear, the encounter not yet over.
     cleared: u64,
-    /// Crossed the ship's heading line ahead of her by its own motion.
+    /// Crossed the ship's heading line ahead of her by its own motion: within the
+    /// encounter, or before it while drawing away from that line.
     crossed: u64,
     /// Past and clear at the last sample.
     past: u64,
@@ -619,7 +620,8 @@ struct Encounters {
     held: [Option<Situation>; MAX_OBSTACLES],
     /// The situation at the last sample (held or present).
     situations: [Option<Situation>; MAX_OBSTACLES],
-    /// Where the ship and the target were at the last sample.
+    /// Where the ship and the target ship were at the last sample (every target ship,
+    /// in an encounter or not).
     sightings: [Option<Sighting>; MAX_OBSTACLES],
 }
 
@@ -844,6 +846,17 @@ impl ReferenceSystem {
             next.held[a.index] = context.held.or((acting && definite).then_some(situation));
             next.sightings[a.index] = Some(sighting);
             if a.crossed {
+                next.crossed |= bit;
+            }
+        } else if let Some(e) = a.encounter {
+            // A target ship not (or no longer) in an encounter is watched too: one that
+            // crosses the ship's heading line ahead of her by its own motion before any
+            // vessel of the tow is within d_D has crossed as much as one seen crossing
+            // within it, for as long as it keeps drawing away from that line (its own
+            // velocity across the line points to the side it is on).
+            next.sightings[a.index] = Some(sighting);
+            let drawing_away = e.bearing.sin() * e.course_difference.sin() > 0.0;
+            if a.crossed && drawing_away && e.target_speed > 0.0 {
                 next.crossed |= bit;
             }
         }
@@ -1269,6 +1282,38 @@ mod tests {
         assert!(held >= 10, "held {held} s past the old release");
         let g = released.expect("released once the resumed track passes clear");
         assert!(g.past_and_clear && g.resume_clear);
+    }
+
+    /// A target that crosses the ship's heading line ahead of her by its own motion
+    /// before any vessel of the tow is within d_D has crossed when the encounter begins,
+    /// and is past and clear once the range opens; one that turns back towards the line
+    /// before the encounter has not.
+    #[test]
+    fn a_crossing_seen_before_the_encounter_counts_while_the_target_draws_away() {
+        let tow = tow_at(Pose::new(0.0, 0.0, 0.0), 0.0);
+        let west = -PI / 2.0;
+        // 12 m ahead (beyond d_D = 7 m of tug 2, 2.1 m ahead), westbound across the bow.
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        rs.update(&tow, &[vessel(12.0, 0.05, west, 0.07)]).unwrap();
+        rs.update(&tow, &[vessel(12.0, -0.05, west, 0.07)]).unwrap();
+        // Later, 8.5 m ahead and 2 m to port, still westbound (and closing: the
+        // range-equivalent distance of a westbound ellipse ahead), within d_D of tug 2.
+        let near = vessel(8.5, -2.0, west, 0.07);
+        let g = rs.update(&tow, &[near]).unwrap().governing.unwrap();
+        assert!(g.detected && g.crossed, "{g:?}");
+        // The same crossing, but the target turned back east (towards the line) before
+        // the encounter: not crossed.
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        rs.update(&tow, &[vessel(12.0, 0.05, west, 0.07)]).unwrap();
+        rs.update(&tow, &[vessel(12.0, -0.05, west, 0.07)]).unwrap();
+        rs.update(&tow, &[vessel(12.0, -0.3, PI / 2.0, 0.07)])
+            .unwrap();
+        let g = rs
+            .update(&tow, &[vessel(8.5, -2.0, west, 0.07)])
+            .unwrap()
+            .governing
+            .unwrap();
+        assert!(g.detected && !g.crossed, "{g:?}");
     }
 
     #[test]
