@@ -47,6 +47,9 @@ pub struct ScoringParams {
     pub action_threshold_deg: f64,
     /// Heading change to port that counts as a port turn in the verdict, deg.
     pub port_turn_deg: f64,
+    /// Speed over ground at or below which the tow has her way off, m/s: taking all way
+    /// off is an action (Rule 8(e)), and so is keeping it off from detection on.
+    pub way_off_speed_m_s: f64,
 }
 
 impl ScoringParams {
@@ -55,9 +58,15 @@ impl ScoringParams {
     /// `r_col = (L + L_target) / 2` (the centres' range at bow-to-bow contact),
     /// `r_nm = L + L_target / 2 + d_S0` (the guidance's safe range for a ship,
     /// `docs/colregs.md` section 1), `r_min = 2 r_nm` (Woerner's `r_min / r_nm` =
-    /// 100 / 50), `r_detect = d_D`.
+    /// 100 / 50), `r_detect = d_D`; `way_off` the speed of a tow with her way off
+    /// (the analyzer's `way_off_surge_m_s`).
     #[must_use]
-    pub fn model_scale(ship_length: f64, target_length: f64, d_detect: f64, d_s0: f64) -> Self {
+    pub fn model_scale(
+        ship_length: f64,
+        target_length: f64,
+        (d_detect, d_s0): (f64, f64),
+        way_off: f64,
+    ) -> Self {
         let r_col = (ship_length + target_length) / 2.0;
         let r_nm = ship_length + target_length / 2.0 + d_s0;
         let r_min = 2.0 * r_nm;
@@ -81,6 +90,7 @@ impl ScoringParams {
             dchi_starboard_deg: 20.0,
             action_threshold_deg: 5.0,
             port_turn_deg: 10.0,
+            way_off_speed_m_s: way_off,
         }
     }
 }
@@ -198,7 +208,7 @@ pub struct EncounterReport {
     /// the first action and the course change are looked for from here.
     pub t_detect_tow_s: Option<f64>,
     /// Time of the tow's first action after detection (the reference becoming altered,
-    /// or the heading changing by the action threshold), s.
+    /// the heading changing by the action threshold, or the way off), s.
     pub t_first_action_s: Option<f64>,
     /// What the first action was.
     pub first_action: Option<String>,
@@ -436,6 +446,8 @@ impl EncounterTracker {
                         "reference altered (waypoint altering, eq. (10)-(11))",
                         range,
                     ));
+                } else if s.own[3] <= self.p.way_off_speed_m_s {
+                    w.action = Some((s.t, "way off (Rule 8(e))", range));
                 } else if dev.abs() >= self.p.action_threshold_deg {
                     w.action = Some((
                         s.t,
@@ -848,7 +860,7 @@ mod tests {
     }
 
     fn params() -> ScoringParams {
-        ScoringParams::model_scale(1.255, 1.48, 7.0, 0.25)
+        ScoringParams::model_scale(1.255, 1.48, (7.0, 0.25), 0.05)
     }
 
     #[test]

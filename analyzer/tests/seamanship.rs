@@ -714,3 +714,92 @@ fn seamanship_a_crossing_seen_before_detection_counts_at_detection() {
     );
     assert_eq!(target.t_past_and_clear_s, Some(t_detect));
 }
+
+#[test]
+fn seamanship_a_target_gone_beyond_detection_and_drawing_away_is_past() {
+    // Regression (random-12-0038, -0042, -0050): a crossing target from starboard, which
+    // the tow let pass by turning 30 deg to starboard and stopping; the turn, not the
+    // target, swept the heading line across it, so it never "crossed ahead". It then
+    // drew away to port, beyond 7 m of every vessel, still forward of the beam; the
+    // guidance released the action as the target had left the encounter, and the
+    // instrument judged it a give-up. Here the target, westbound at 0.05 m/s, is 6.4 m
+    // off on the starboard bow (20 deg) when the tow turns at 295-310 s.
+    let crossing = || Target {
+        name: "crossing",
+        at_t0: [25.5, 2.2 + 0.05 * 300.0],
+        course_deg: 270.0,
+        speed: 0.05,
+    };
+    let turn_and_stop = |resume: f64| {
+        move |t: f64, p: [f64; 2]| {
+            if t > 295.0 && t <= resume {
+                (((t - 295.0) * 2.0).min(30.0), 0.0, 0.0)
+            } else {
+                cruise(t, p)
+            }
+        }
+    };
+    // Resumed at 500 s: the target has been beyond 7 m of tug 2 (the nearest vessel)
+    // since about 442 s, 52 deg on the port bow of the ship then, drawing away.
+    let r = run(800.0, turn_and_stop(500.0), no_offset, &[crossing()]);
+    let target = &r.rules.targets[0];
+    assert_eq!(target.situation.as_deref(), Some("crossing give-way"));
+    assert_eq!(
+        target.past_and_clear.as_deref(),
+        Some("gone beyond the detection distance, drawing away"),
+        "{target:?}"
+    );
+    let t_clear = target.t_past_and_clear_s.expect("past");
+    assert!((430.0..=460.0).contains(&t_clear), "{t_clear}");
+    assert!(target.given_up.is_none(), "{target:?}");
+    assert!(!metrics(&verdict(&r)).contains(&"rule8_past_and_clear"));
+    // Resumed at 400 s, with the target 6.6 m off the ship and nearer the forward tug:
+    // still in the encounter, and the release is a give-up.
+    let r = run(800.0, turn_and_stop(400.0), no_offset, &[crossing()]);
+    let target = &r.rules.targets[0];
+    assert!(target.given_up.is_some(), "{target:?}");
+    assert!(metrics(&verdict(&r)).contains(&"rule8_past_and_clear"));
+}
+
+#[test]
+fn seamanship_rule_17_allows_action_by_the_cpa_before_detection() {
+    // Regression (random-12-0012): the guidance acts for a stand-on target by its CPA,
+    // wherever it is; the tow took her way off at a TCPA of about 52 s, 2 s before her
+    // forward tug came within 7 m, and the instrument, looking for Rule 17's TCPA only
+    // from detection, found it pushed back over 60 s by her own braking and held her to
+    // her course and speed. Here a target from the port bow (course 150 deg, 0.12 m/s)
+    // is on a collision course with the cruising tow (CPA at x = 30 m, 461.5 s); the tow
+    // stops at a TCPA of 55 s (406.5 s, the forward tug 8 m off), the forward tug comes
+    // within 7 m about 8.5 s later (the TCPA then 72 s) and she turns 21 deg to
+    // starboard at 417-424 s.
+    let t_cpa = 30.0 / CRUISE;
+    let (s, c) = 150f64.to_radians().sin_cos();
+    let target = Target {
+        name: "from port",
+        at_t0: [30.0 - 0.12 * c * t_cpa, -0.12 * s * t_cpa],
+        course_deg: 150.0,
+        speed: 0.12,
+    };
+    let stop_and_turn = move |t: f64, p: [f64; 2]| {
+        if t > t_cpa - 55.0 {
+            (((t - 417.0) * 3.0).clamp(0.0, 21.0), 0.0, 0.0)
+        } else {
+            cruise(t, p)
+        }
+    };
+    let r = run(600.0, stop_and_turn, no_offset, &[target]);
+    let target = &r.rules.targets[0];
+    assert_eq!(
+        target.situation.as_deref(),
+        Some("crossing stand-on"),
+        "{target:?}"
+    );
+    let (t_detect, t_rule17) = (
+        target.t_detect_s.expect("detected"),
+        target.t_rule17_s.expect("rule 17"),
+    );
+    assert!((410.0..=417.0).contains(&t_detect), "{target:?}");
+    assert!((t_rule17 - (t_cpa - 60.0)).abs() <= 0.5, "{target:?}");
+    assert!(target.t_stand_on_broken_s.is_none(), "{target:?}");
+    assert!(!metrics(&verdict(&r)).contains(&"rule17_stand_on"));
+}

@@ -43,6 +43,8 @@ pub struct Encounters {
     ship_length: f64,
     detection: f64,
     safety_buffer: f64,
+    /// Speed of a tow with her way off (the analyzer's `way_off_surge_m_s`), m/s.
+    way_off: f64,
     /// The route's course, against which course changes are measured.
     course: RouteCourse,
     slots: Vec<Slot>,
@@ -145,6 +147,7 @@ impl Metric for Encounters {
             ship_length: run.config.ship_size[0],
             detection: run.config.detection_distance_m,
             safety_buffer: run.config.safety_buffer_m,
+            way_off: run.thresholds.way_off_surge_m_s,
             course: RouteCourse::new(&run.geometry.route, run.thresholds.route_course_lookahead_m),
             slots: Vec::new(),
             reports: None,
@@ -158,6 +161,7 @@ impl Metric for Encounters {
         let window = 2.0 * self.detection;
         for i in 0..rows.len() {
             let (l, d, s0) = (self.ship_length, self.detection, self.safety_buffer);
+            let way_off = self.way_off;
             let k = slot_index(
                 &mut self.slots,
                 rows.slot[i],
@@ -166,7 +170,7 @@ impl Metric for Encounters {
                     slot: u32::try_from(rows.slot[i]).unwrap_or(0),
                     name: rows.name(i).to_owned(),
                     tracker: (rows.kind[i] as i64 == 2).then(|| {
-                        EncounterTracker::new(ScoringParams::model_scale(l, rows.obs(i)[4], d, s0))
+                        EncounterTracker::new(ScoringParams::model_scale(l, rows.obs(i)[4], (d, s0), way_off))
                     }),
                     near: 0,
                     closest: None,

@@ -25,7 +25,8 @@
 //! - head-on (Rule 14): a starboard alteration of at least `head_on_turn_deg` before the
 //!   CPA and a port-to-port pass (the target on the ship's port side at the CPA);
 //! - stand-on (Rule 17; crossing stand-on, being overtaken): until Rule 17(a)(ii) allows
-//!   action (TCPA <= `rule17_tcpa_s`), heading within `stand_on_course_deg` and speed over
+//!   action (TCPA <= `rule17_tcpa_s`, from the first step the target is present: before
+//!   detection with a DCPA within `d_detect` too), heading within `stand_on_course_deg` and speed over
 //!   ground at least `stand_on_speed_fraction` of their values at detection; Rule 17(c):
 //!   never a port turn of more than `port_turn_max_deg` while the target is on the port
 //!   side, until it is past and clear;
@@ -40,12 +41,18 @@
 //! of its side, [`crate::geometry::crossed_ahead`]: neither the tow's turn nor its sideways
 //! motion alone makes the crossing, and the verdict does not depend on the step size); in
 //! any situation, it is abaft the ship's
-//! beam with the range opening while the tow makes way (surge > `way_off_surge_m_s`). A
+//! beam with the range opening while the tow makes way (surge > `way_off_surge_m_s`), or
+//! it has gone: beyond `d_detect` of every vessel of the tow, on the side of the ship's
+//! heading line its own velocity carries it away from, that velocity opening the range
+//! from the ship (its track no longer meets the heading line ahead of her, and the range
+//! is the target's doing, not the tow's braking: a crossing target the tow let pass by
+//! turning away from it and stopping, which the guidance releases once it has left the
+//! encounter distance, `docs/colregs.md`). A
 //! crossing seen before detection counts at detection if the target has kept drawing away
 //! from the heading line since ("crossed ahead before detection": it crossed ahead of the
 //! ship by its own motion before any vessel of the tow was within `d_detect`). A
 //! head-on or overtaking target moves along the tow's track, not across it: its side of the
-//! heading line changes with a wobble of either vessel, so only the second test applies.
+//! heading line changes with a wobble of either vessel, so only the last two tests apply.
 
 use serde::{Deserialize, Serialize};
 
@@ -136,7 +143,8 @@ pub struct TargetRules {
     pub given_up: Option<GiveUp>,
     /// The first crossing ahead of the target closer than `cross_ahead_min_m`.
     pub crossed_ahead: Option<CrossAhead>,
-    /// When Rule 17 allowed the stand-on vessel to act (TCPA <= `rule17_tcpa_s`), s.
+    /// When Rule 17 allowed the stand-on vessel to act (TCPA <= `rule17_tcpa_s`; before
+    /// detection also with the DCPA within `d_detect`), s.
     pub t_rule17_s: Option<f64>,
     /// Largest heading change before then, deg.
     pub stand_on_course_change_deg: Option<f64>,
@@ -294,6 +302,23 @@ impl Target {
         }
     }
 
+    /// Before detection, latches Rule 17's permission once the target is closing to a CPA
+    /// within `d_detect` of the ship at most `rule17_tcpa_s` away: Rule 17(a)(ii) lets the
+    /// stand-on vessel act as soon as the give-way vessel's failure is apparent, wherever
+    /// it is (the guidance acts by the CPA, not by `d_detect`: random-12-0012's tow took
+    /// its way off at a TCPA of 52 s, 2 s before the forward tug came within 7 m, and was
+    /// then judged on the speed it had kept at detection).
+    fn watch_rule17(&mut self, t: f64, ship: &Vessel, o: &Obstacle, (d_detect, th): (f64, &Thresholds)) {
+        if self.det.is_some() || self.r.t_rule17_s.is_some() {
+            return;
+        }
+        let v_target = course_velocity(o.course, o.speed);
+        let (tcpa, dcpa) = cpa_tcpa([ship.x, ship.y], ship.vel_n(), [o.x, o.y], v_target);
+        if (0.0..=th.rule17_tcpa_s).contains(&tcpa) && dcpa < d_detect {
+            self.r.t_rule17_s = Some(t);
+        }
+    }
+
     /// Detection at this step if any vessel of the tow is within `d_detect`.
     fn detect(&mut self, t: f64, (ship, course): (&Vessel, f64), vessels: &[Vessel; 3], o: &Obstacle, d: f64) {
         let tp = [o.x, o.y];
@@ -317,7 +342,13 @@ impl Target {
     }
 
     /// One step of the checks after detection.
-    fn observe(&mut self, t: f64, (tow, course): (Tow<'_>, f64), o: &Obstacle, th: &Thresholds) {
+    fn observe(
+        &mut self,
+        t: f64,
+        (tow, course, d_detect): (Tow<'_>, f64, f64),
+        o: &Obstacle,
+        th: &Thresholds,
+    ) {
         let Some(det) = self.det else { return };
         let ship = tow.0[0];
         let (sp, tp) = ([ship.x, ship.y], [o.x, o.y]);
@@ -333,7 +364,7 @@ impl Target {
             self.r.beta_cpa_deg = Some(beta);
             self.r.starboard_turn_to_cpa_deg = Some(self.stbd_max);
         }
-        self.past_and_clear(t, &ship, o, th);
+        self.past_and_clear(t, (tow.0, d_detect), o, th);
         self.give_way_action(t, &ship, (range, beta, turn), th);
         self.cross_ahead(t, tow.0, o, th);
         self.stand_on(t, &ship, v_target, o, (turn, beta), th);
@@ -341,7 +372,14 @@ impl Target {
     }
 
     /// Rule 8(d): latches past and clear (see the module's doc).
-    fn past_and_clear(&mut self, t: f64, ship: &Vessel, o: &Obstacle, th: &Thresholds) {
+    fn past_and_clear(
+        &mut self,
+        t: f64,
+        (vessels, d_detect): (&[Vessel; 3], f64),
+        o: &Obstacle,
+        th: &Thresholds,
+    ) {
+        let ship = &vessels[0];
         let (sp, tp) = ([ship.x, ship.y], [o.x, o.y]);
         let prev = self.prev_pose.replace((sp, ship.psi, tp));
         if self.r.t_past_and_clear_s.is_some() {
@@ -361,15 +399,27 @@ impl Target {
         let opening = range_rate(sp, ship.vel_n(), tp, course_velocity(o.course, o.speed)) > 0.0;
         let abaft =
             beta.abs() > std::f64::consts::FRAC_PI_2 && opening && ship.u > th.way_off_surge_m_s;
-        if crossed || abaft {
+        // Gone: beyond d_detect of every vessel of the tow, on the side of the ship's
+        // heading line its own velocity carries it away from, and that velocity opening
+        // the range from the ship: its track no longer meets the tow's heading line
+        // ahead of her, and neither the tow's braking nor her sternway made the range.
+        let v_target = course_velocity(o.course, o.speed);
+        let (_, side) = line_coordinates(sp, ship.psi, tp);
+        let (_, across) = line_coordinates([0.0, 0.0], ship.psi, v_target);
+        let away = (tp[0] - sp[0]) * v_target[0] + (tp[1] - sp[1]) * v_target[1] > 0.0;
+        let beyond = vessels.iter().all(|v| dist([v.x, v.y], tp) > d_detect);
+        let gone = beyond && side * across > 0.0 && away;
+        if crossed || abaft || gone {
             self.r.t_past_and_clear_s = Some(t);
             self.r.past_and_clear = Some(
                 if crossed && before {
                     "crossed ahead before detection"
                 } else if crossed {
                     "crossed ahead"
-                } else {
+                } else if abaft {
                     "abaft the beam, opening"
+                } else {
+                    "gone beyond the detection distance, drawing away"
                 }
                 .to_owned(),
             );
@@ -566,8 +616,14 @@ impl RulesTracker {
             target.present = true;
             target.watch_controller(step);
             target.watch_crossing(&ship, o);
+            target.watch_rule17(step.t, &ship, o, (self.d_detect, &self.th));
             target.detect(step.t, (&ship, course), &step.vessels, o, self.d_detect);
-            target.observe(step.t, ((&step.vessels, &self.sizes), course), o, &self.th);
+            target.observe(
+                step.t,
+                ((&step.vessels, &self.sizes), course, self.d_detect),
+                o,
+                &self.th,
+            );
         }
         // The controller may report a target's situation before it is among the active
         // obstacles of a step only in a malformed log; such reports are not kept.
