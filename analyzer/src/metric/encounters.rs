@@ -160,8 +160,7 @@ impl Metric for Encounters {
         };
         let window = 2.0 * self.detection;
         for i in 0..rows.len() {
-            let (l, d, s0) = (self.ship_length, self.detection, self.safety_buffer);
-            let way_off = self.way_off;
+            let (l, d, s0, way_off) = (self.ship_length, self.detection, self.safety_buffer, self.way_off);
             let k = slot_index(
                 &mut self.slots,
                 rows.slot[i],

@@ -202,6 +202,19 @@ struct Target {
 /// Own vessels with the sizes, as the checks need them.
 type Tow<'s> = (&'s [Vessel; 3], &'s [[f64; 2]; 3]);
 
+/// The target's side of the ship's heading line and its own velocity across that line
+/// (both + starboard): it draws away from the line when their product is positive.
+fn side_and_drift(ship: &Vessel, o: &Obstacle) -> (f64, f64) {
+    let (_, side) = line_coordinates([ship.x, ship.y], ship.psi, [o.x, o.y]);
+    let (_, drift) = line_coordinates([0.0, 0.0], ship.psi, course_velocity(o.course, o.speed));
+    (side, drift)
+}
+
+/// Whether any vessel of the tow is within `d` of the point `p`.
+fn any_within(vessels: &[Vessel; 3], p: [f64; 2], d: f64) -> bool {
+    vessels.iter().any(|v| dist([v.x, v.y], p) < d)
+}
+
 impl Target {
     fn new(o: &Obstacle) -> Self {
         Target {
@@ -292,8 +305,7 @@ impl Target {
         }
         let (sp, tp) = ([ship.x, ship.y], [o.x, o.y]);
         let prev = self.prev_pose.replace((sp, ship.psi, tp));
-        let (_, side) = line_coordinates(sp, ship.psi, tp);
-        let (_, drift) = line_coordinates([0.0, 0.0], ship.psi, course_velocity(o.course, o.speed));
+        let (side, drift) = side_and_drift(ship, o);
         if prev.is_some_and(|p| crossed_ahead(p, (sp, ship.psi, tp))) && side != 0.0 {
             self.crossed_before = Some(side.signum());
         }
@@ -322,7 +334,7 @@ impl Target {
     /// Detection at this step if any vessel of the tow is within `d_detect`.
     fn detect(&mut self, t: f64, (ship, course): (&Vessel, f64), vessels: &[Vessel; 3], o: &Obstacle, d: f64) {
         let tp = [o.x, o.y];
-        if self.det.is_some() || !vessels.iter().any(|v| dist([v.x, v.y], tp) < d) {
+        if self.det.is_some() || !any_within(vessels, tp, d) {
             return;
         }
         let sp = [ship.x, ship.y];
@@ -396,19 +408,17 @@ impl Target {
         let crossed =
             crossing && (before || prev.is_some_and(|p| crossed_ahead(p, (sp, ship.psi, tp))));
         let beta = relative_bearing(sp, ship.psi, tp);
-        let opening = range_rate(sp, ship.vel_n(), tp, course_velocity(o.course, o.speed)) > 0.0;
+        let v_target = course_velocity(o.course, o.speed);
+        let opening = range_rate(sp, ship.vel_n(), tp, v_target) > 0.0;
         let abaft =
             beta.abs() > std::f64::consts::FRAC_PI_2 && opening && ship.u > th.way_off_surge_m_s;
         // Gone: beyond d_detect of every vessel of the tow, on the side of the ship's
         // heading line its own velocity carries it away from, and that velocity opening
         // the range from the ship: its track no longer meets the tow's heading line
         // ahead of her, and neither the tow's braking nor her sternway made the range.
-        let v_target = course_velocity(o.course, o.speed);
-        let (_, side) = line_coordinates(sp, ship.psi, tp);
-        let (_, across) = line_coordinates([0.0, 0.0], ship.psi, v_target);
-        let away = (tp[0] - sp[0]) * v_target[0] + (tp[1] - sp[1]) * v_target[1] > 0.0;
-        let beyond = vessels.iter().all(|v| dist([v.x, v.y], tp) > d_detect);
-        let gone = beyond && side * across > 0.0 && away;
+        let (side, drift) = side_and_drift(ship, o);
+        let away = range_rate(sp, [0.0, 0.0], tp, v_target) > 0.0;
+        let gone = !any_within(vessels, tp, d_detect) && side * drift > 0.0 && away;
         if crossed || abaft || gone {
             self.r.t_past_and_clear_s = Some(t);
             self.r.past_and_clear = Some(
