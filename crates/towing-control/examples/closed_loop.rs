@@ -177,9 +177,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(v) = env("COURSE_LEAD") {
         config.tuning.tracking.course_lead = v.to_radians();
     }
-    if let Some(v) = env("APPROACH") {
-        config.tuning.tracking.approach_angle = v.to_radians();
-    }
     if let Some(v) = env("W_R") {
         config.tuning.ship.weight_yaw_rate = v;
     }

@@ -224,15 +224,6 @@ pub struct TrackingParams {
     /// Largest angle (rad) between the reference course and the ship's heading;
     /// 0: no limit.
     pub course_lead: f64,
-    /// Largest angle (rad) at which the tracked course approaches the route
-    /// when the ship is off it and the route is not altered (the return to the
-    /// route after an alteration is released, a start off the route): the
-    /// lookahead grows to `|cross-track| / tan(approach_angle)`, so the
-    /// line-of-sight course lies at most this far off the leg's (a bounded
-    /// approach angle, Nelson et al. 2007, "Vector field path following for
-    /// miniature air vehicles", IEEE T-RO 23(3): the approach angle chi_inf of
-    /// their straight-line vector field); 0: no bound.
-    pub approach_angle: f64,
 }
 
 impl Default for TrackingParams {
@@ -253,7 +244,6 @@ impl Default for TrackingParams {
             port_turn_margin: 2f64.to_radians(),
             course_rate: 1.5f64.to_radians(),
             course_lead: 20f64.to_radians(),
-            approach_angle: 30f64.to_radians(),
         }
     }
 }

@@ -876,11 +876,8 @@ impl Controller {
             let len = seg[0].hypot(seg[1]);
             if len > 0.0 {
                 let e = [seg[0] / len, seg[1] / len];
-                let (rx, ry) = (ship[0] - prev.x, ship[1] - prev.y);
-                let along = (rx * e[0] + ry * e[1]).clamp(0.0, len);
+                let along = ((ship[0] - prev.x) * e[0] + (ship[1] - prev.y) * e[1]).clamp(0.0, len);
                 let remaining = len - along;
-                let lookahead =
-                    self.approach_lookahead(lookahead, (e[0] * ry - e[1] * rx).abs(), altered);
                 if remaining >= lookahead || (altered && active < last) {
                     // An altered waypoint is a direction, not a place to stop at:
                     // the point runs on past it along the altered leg.
@@ -902,23 +899,6 @@ impl Controller {
             }
         }
         self.steer(ship, goal, floor)
-    }
-
-    /// The lookahead that keeps the line of sight within
-    /// [`TrackingParams::approach_angle`](crate::TrackingParams) of the leg when
-    /// the ship is `cross_track` metres off an unaltered route:
-    /// `max(lookahead, cross_track / tan(approach_angle))`. After a released
-    /// alteration the ship lies up to 4 m off the route, and the 3.5 m lookahead
-    /// alone turned her back at 40-50 deg, across the bow of a crossing target
-    /// coming up on her port side (Rule 17(c)) and past the route course
-    /// (`docs/controller-design.md`, "Reference course"). An altered leg keeps
-    /// its lookahead: its course is the COLREGS action.
-    fn approach_lookahead(&self, lookahead: f64, cross_track: f64, altered: bool) -> f64 {
-        let angle = self.config.tuning.tracking.approach_angle;
-        if altered || angle <= 0.0 {
-            return lookahead;
-        }
-        lookahead.max(cross_track / angle.tan())
     }
 
     /// The reference pose the MPC tracks, from the tracked point `goal`

@@ -827,18 +827,6 @@ pub static PARAMETERS: &[Parameter] = &[
         },
     },
     Parameter {
-        name: "tracking.approach_angle",
-        old_name: None,
-        description: "Largest angle between the tracked course and the route's leg while the ship returns to an unaltered route from off it: the lookahead grows with the cross-track distance (a bounded approach angle, Nelson et al. 2007); 30 deg: an intercept of 40-50 deg after a released alteration swung the tow across the bow of the next crossing target (docs/assumptions.md); 0: no bound",
-        kind: Kind::Real {
-            unit: "rad",
-            min: Limit::AtLeast(0.0),
-            max: Limit::Below(std::f64::consts::FRAC_PI_2),
-            get: |t| t.tracking.approach_angle,
-            set: |t, v| t.tracking.approach_angle = v,
-        },
-    },
-    Parameter {
         name: "tracking.give_way_way_off",
         old_name: None,
         description: "true: while the route is altered for a crossing in which the tow gives way, she takes the way off (tracking.give_way_deceleration) and keeps it off (tracking.give_way_surge) until the encounter is over (COLREGS Rule 8(e)); false (default): the motion limits only (docs/assumptions.md: more random encounters pass with it, but the paper scenario's distributed scheme I exceeds its 10 % elongation expectation)",

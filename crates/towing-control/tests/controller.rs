@@ -604,43 +604,6 @@ fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
     assert_eq!(three.sample(&m).unwrap().heading_floor, None);
 }
 
-/// Returning to an unaltered route from 4 m off it, the line of sight approaches the
-/// leg at most `tracking.approach_angle` (30 deg) off its course; without the bound
-/// (0) the 3.5 m lookahead asks for atan(4 / 3.5) = 48.8 deg.
-#[test]
-fn the_return_to_the_route_approaches_it_at_a_bounded_angle() {
-    let (scenario, mut m) = paper_measurement();
-    for o in &mut m.obstacles {
-        o.kind = ObstacleKind::None;
-    }
-    let (a, b) = (scenario.route.origin, scenario.route.waypoints[0]);
-    let chi = (b.y - a.y).atan2(b.x - a.x);
-    let off = 4.0;
-    // 1 m along the first leg, 4 m to starboard of it, heading 30 deg to port of it.
-    m.ship[0] = a.x + chi.cos() - off * chi.sin();
-    m.ship[1] = a.y + chi.sin() + off * chi.cos();
-    m.ship[2] = chi - 30f64.to_radians();
-    let course_after = |approach: f64| {
-        let mut config = ControllerConfig::new(scenario.clone());
-        config.tuning.tracking.approach_angle = approach;
-        let mut c = Controller::new(config).unwrap();
-        let mut course = 0.0;
-        for _ in 0..40 {
-            course = c.sample(&m).unwrap().reference[2];
-        }
-        towing_model::wrap_angle(course - chi).to_degrees()
-    };
-    let bounded = course_after(30f64.to_radians());
-    assert!((bounded + 30.0).abs() < 1e-6, "{bounded}");
-    let lookahead = ControllerConfig::new(scenario.clone())
-        .tuning
-        .tracking
-        .lookahead;
-    let free = course_after(0.0);
-    let expected = -(off / lookahead).atan().to_degrees();
-    assert!((free - expected).abs() < 1e-6, "{free} vs {expected}");
-}
-
 /// The controller's own clock: a sample at the first step and every T_s after
 /// (a communication point within 1 us of an instant samples; one that falls
 /// between instants does not), the command between samples from the inner loop.
