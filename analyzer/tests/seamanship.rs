@@ -569,6 +569,44 @@ fn seamanship_head_on_port_to_port_with_a_starboard_turn_passes() {
     assert!(why.is_empty(), "{why:?}");
 }
 
+/// Head-on with the tow fine on the target's starboard bow (the target 0.3 m east of the
+/// route, heading south): her 15 deg starboard alteration takes the forward tug and then
+/// the ship across the target's course line ahead of it, to its port side, as Rule 14
+/// asks; that crossing is no reason. A port alteration from its port bow crosses onto
+/// its starboard side: that one is.
+#[test]
+fn seamanship_head_on_crossing_ahead_counts_only_onto_the_targets_starboard_side() {
+    let turn = |deg: f64| {
+        move |t: f64, p: [f64; 2]| {
+            if t > 395.0 && t <= 500.0 {
+                (deg, CRUISE, 0.0)
+            } else {
+                cruise(t, p)
+            }
+        }
+    };
+    let r = run(900.0, turn(15.0), no_offset, &[head_on(0.3)]);
+    let target = &r.rules.targets[0];
+    assert_eq!(target.situation.as_deref(), Some("head-on"));
+    let c = target.crossed_ahead.as_ref().expect("a crossing ahead");
+    assert!(c.range_m < 7.0, "{c:?}");
+    assert_eq!(target.crossed_ahead_to_starboard, None);
+    assert!(target.beta_cpa_deg.expect("cpa") < 0.0);
+    let why = verdict(&r);
+    assert!(why.is_empty(), "{why:?}");
+
+    let r = run(900.0, turn(-15.0), no_offset, &[head_on(-0.3)]);
+    let target = &r.rules.targets[0];
+    assert_eq!(target.situation.as_deref(), Some("head-on"));
+    assert!(target.crossed_ahead_to_starboard.is_some());
+    let why = verdict(&r);
+    assert!(
+        why.iter()
+            .any(|r| r.metric == "rule14_head_on" && r.message.contains("crossed ahead")),
+        "{why:?}"
+    );
+}
+
 #[test]
 fn seamanship_head_on_starboard_to_starboard_is_a_reason() {
     let r = run(900.0, cruise, no_offset, &[head_on(1.0)]);
@@ -650,12 +688,14 @@ fn seamanship_own_turn_is_not_the_target_crossing_ahead() {
         target.t_past_and_clear_s.expect("past") > 450.0,
         "{target:?}"
     );
-    // Not given up; but the turn swings tug 2 (2 m ahead of the ship) across the target's
-    // course line ahead of it, within 7 m of it: that is a reason (Rule 14's crossing
-    // check), and the only one.
+    // Not given up. The turn swings tug 2 (2 m ahead of the ship) across the target's
+    // course line ahead of it, within 7 m of it, onto its port side: the port-to-port
+    // side Rule 14 asks for, so no reason.
+    let c = target.crossed_ahead.as_ref().expect("tug 2 crossed");
+    assert_eq!(c.vessel, "tug2");
+    assert_eq!(target.crossed_ahead_to_starboard, None);
     let why = verdict(&r);
-    assert_eq!(metrics(&why), ["rule14_head_on"], "{why:?}");
-    assert!(why[0].message.starts_with("tug2 crossed ahead"), "{why:?}");
+    assert!(why.is_empty(), "{why:?}");
 }
 
 #[test]

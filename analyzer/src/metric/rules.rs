@@ -20,8 +20,10 @@
 //!   starboard of its detection heading still coming round at `give_way_turn_rate_deg_s`
 //!   or more holds it too (the tow gathering way as she alters);
 //! - no vessel of the tow crosses ahead of a give-way target closer than
-//!   `cross_ahead_min_m` (Rule 15: "avoid crossing ahead"; the same check for head-on and
-//!   overtaking under their rule);
+//!   `cross_ahead_min_m` (Rule 15: "avoid crossing ahead"; the same check for overtaking
+//!   under Rule 13; head-on, only a crossing onto the target's starboard side counts,
+//!   since Rule 14's starboard alteration takes a tow lying fine on the target's
+//!   starboard bow across its course line to its port side);
 //! - head-on (Rule 14): a starboard alteration of at least `head_on_turn_deg` before the
 //!   CPA and a port-to-port pass (the target on the ship's port side at the CPA);
 //! - stand-on (Rule 17; crossing stand-on, being overtaken): until Rule 17(a)(ii) allows
@@ -143,6 +145,9 @@ pub struct TargetRules {
     pub given_up: Option<GiveUp>,
     /// The first crossing ahead of the target closer than `cross_ahead_min_m`.
     pub crossed_ahead: Option<CrossAhead>,
+    /// The first of those onto the target's starboard side (the side of a
+    /// starboard-to-starboard pass; the only one head-on counts, Rule 14).
+    pub crossed_ahead_to_starboard: Option<CrossAhead>,
     /// When Rule 17 allowed the stand-on vessel to act (TCPA <= `rule17_tcpa_s`; before
     /// detection also with the DCPA within `d_detect`), s.
     pub t_rule17_s: Option<f64>,
@@ -238,6 +243,7 @@ impl Target {
                 past_and_clear: None,
                 given_up: None,
                 crossed_ahead: None,
+                crossed_ahead_to_starboard: None,
                 t_rule17_s: None,
                 stand_on_course_change_deg: None,
                 stand_on_speed_fraction: None,
@@ -474,7 +480,8 @@ impl Target {
         self.acting = acting || (self.acting && swinging);
     }
 
-    /// Rule 15: a vessel of the tow crossing the target's course line ahead of it, close.
+    /// Rule 15: a vessel of the tow crossing the target's course line ahead of it, close
+    /// (the first crossing, and the first onto the target's starboard side).
     fn cross_ahead(&mut self, t: f64, vessels: &[Vessel; 3], o: &Obstacle, th: &Thresholds) {
         let tp = [o.x, o.y];
         for (k, v) in vessels.iter().enumerate() {
@@ -485,16 +492,19 @@ impl Target {
             }
             let changed = prev.is_some_and(|p| p * side < 0.0);
             let range = dist([v.x, v.y], tp);
-            if changed
-                && along > 0.0
-                && range < th.cross_ahead_min_m
-                && self.r.crossed_ahead.is_none()
-            {
-                self.r.crossed_ahead = Some(CrossAhead {
-                    t_s: t,
-                    vessel: VESSELS[k].to_owned(),
-                    range_m: range,
-                });
+            if !(changed && along > 0.0 && range < th.cross_ahead_min_m) {
+                continue;
+            }
+            let crossing = CrossAhead {
+                t_s: t,
+                vessel: VESSELS[k].to_owned(),
+                range_m: range,
+            };
+            if side > 0.0 && self.r.crossed_ahead_to_starboard.is_none() {
+                self.r.crossed_ahead_to_starboard = Some(crossing.clone());
+            }
+            if self.r.crossed_ahead.is_none() {
+                self.r.crossed_ahead = Some(crossing);
             }
         }
     }
@@ -731,7 +741,16 @@ fn give_way_reasons(r: &TargetRules, s: Situation, th: &Thresholds, out: &mut Ve
             ),
         ));
     }
-    if let Some(c) = &r.crossed_ahead {
+    // Head-on, the tow's starboard alteration takes her to the target's port side
+    // (Rule 14: port to port); when she lies fine on its starboard bow that is across
+    // its course line ahead of it, which the rule asks for. Crossing onto its
+    // starboard side is the violation.
+    let crossed = if s == Situation::HeadOn {
+        &r.crossed_ahead_to_starboard
+    } else {
+        &r.crossed_ahead
+    };
+    if let Some(c) = crossed {
         out.push(Reason::target(
             give_way_rule(s),
             name,
