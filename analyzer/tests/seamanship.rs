@@ -541,17 +541,22 @@ fn head_on(east: f64) -> Target {
     }
 }
 
-#[test]
-fn seamanship_head_on_port_to_port_with_a_starboard_turn_passes() {
-    // Detected at about 392 s (tug 2 within 7 m); 15 deg to starboard from 395 s to 500 s.
-    let turn = |t: f64, p: [f64; 2]| {
+/// Cruise, but with the heading at `deg` (deg, + starboard) from 395 s to 500 s: against
+/// a `head_on` target, from just after detection (about 392 s, tug 2 within 7 m).
+fn head_on_turn(deg: f64) -> impl Fn(f64, [f64; 2]) -> (f64, f64, f64) {
+    move |t: f64, p: [f64; 2]| {
         if t > 395.0 && t <= 500.0 {
-            (15.0, CRUISE, 0.0)
+            (deg, CRUISE, 0.0)
         } else {
             cruise(t, p)
         }
-    };
-    let r = run(900.0, turn, no_offset, &[head_on(-0.3)]);
+    }
+}
+
+#[test]
+fn seamanship_head_on_port_to_port_with_a_starboard_turn_passes() {
+    // Detected at about 392 s (tug 2 within 7 m); 15 deg to starboard from 395 s to 500 s.
+    let r = run(900.0, head_on_turn(15.0), no_offset, &[head_on(-0.3)]);
     let target = &r.rules.targets[0];
     assert_eq!(target.situation.as_deref(), Some("head-on"));
     assert!(target.beta_cpa_deg.expect("cpa") < 0.0);
@@ -576,16 +581,7 @@ fn seamanship_head_on_port_to_port_with_a_starboard_turn_passes() {
 /// its starboard side: that one is.
 #[test]
 fn seamanship_head_on_crossing_ahead_counts_only_onto_the_targets_starboard_side() {
-    let turn = |deg: f64| {
-        move |t: f64, p: [f64; 2]| {
-            if t > 395.0 && t <= 500.0 {
-                (deg, CRUISE, 0.0)
-            } else {
-                cruise(t, p)
-            }
-        }
-    };
-    let r = run(900.0, turn(15.0), no_offset, &[head_on(0.3)]);
+    let r = run(900.0, head_on_turn(15.0), no_offset, &[head_on(0.3)]);
     let target = &r.rules.targets[0];
     assert_eq!(target.situation.as_deref(), Some("head-on"));
     let c = target.crossed_ahead.as_ref().expect("a crossing ahead");
@@ -595,7 +591,7 @@ fn seamanship_head_on_crossing_ahead_counts_only_onto_the_targets_starboard_side
     let why = verdict(&r);
     assert!(why.is_empty(), "{why:?}");
 
-    let r = run(900.0, turn(-15.0), no_offset, &[head_on(-0.3)]);
+    let r = run(900.0, head_on_turn(-15.0), no_offset, &[head_on(-0.3)]);
     let target = &r.rules.targets[0];
     assert_eq!(target.situation.as_deref(), Some("head-on"));
     assert!(target.crossed_ahead_to_starboard.is_some());
@@ -669,14 +665,7 @@ fn seamanship_own_turn_is_not_the_target_crossing_ahead() {
     // Head-on, the target 0.05 m to starboard of the route: the tow's 15 deg starboard
     // turn puts it on the port side of the ship's heading line, but by the ship's motion,
     // not the target's, so it is not past and clear until it is abaft the beam.
-    let turn = |t: f64, p: [f64; 2]| {
-        if t > 395.0 && t <= 500.0 {
-            (15.0, CRUISE, 0.0)
-        } else {
-            cruise(t, p)
-        }
-    };
-    let r = run(900.0, turn, no_offset, &[head_on(0.05)]);
+    let r = run(900.0, head_on_turn(15.0), no_offset, &[head_on(0.05)]);
     let target = &r.rules.targets[0];
     assert_eq!(target.situation.as_deref(), Some("head-on"));
     assert_eq!(
