@@ -1195,9 +1195,11 @@ fn mpc_obstacle(o: &ObstacleSlot, sample_time: f64) -> Obstacle {
 }
 
 /// The ship's and the tugs' MPC parameters a [`Controller`] of `config` uses: the
-/// tuning's, with the distance weights zeroed when the scheme has no distance cost
-/// (scheme II), and without the bank, tug yaw-rate and own-ship rows in scheme III (the paper's
-/// baseline keeps its printed formulation).
+/// tuning's, with the bank rows when [`ControllerConfig::mpc_waterway_half_width`] gives
+/// a waterway (schemes I and II) and the distance weights zeroed when the scheme has no
+/// distance cost (scheme II). Every scheme keeps
+/// the tugs' yaw-rate and own-ship rows: they model the tugs, not the avoidance
+/// (`docs/assumptions.md`, "SCP trust region").
 #[must_use]
 pub fn mpc_params(
     config: &ControllerConfig,
@@ -1205,17 +1207,6 @@ pub fn mpc_params(
     let (mut ship, mut tug) = (config.tuning.ship, config.tuning.tug);
     ship.waterway_rows = config.mpc_waterway_half_width().is_some();
     tug.waterway_rows = ship.waterway_rows;
-    if !config.tuning.scheme.alters() {
-        // Scheme III, the paper's distance-cost-only baseline, keeps eq. (16) as printed.
-        tug.max_yaw_rate = f64::INFINITY;
-        tug.own_ship_row = false;
-        // Its tugs, without the yaw rows, spin (21 rad/s in the paper run); any
-        // change of the coordination's steps moves where a spin overflows, and with
-        // the trust regions reopened each sample its paper run fell back 7 times and
-        // the ship met a tug. It keeps the regions it had.
-        ship.scp.reopen = false;
-        tug.scp.reopen = false;
-    }
     if !config.tuning.scheme.distance_cost() {
         ship.weight_distance = 0.0;
         tug.weight_distance = 0.0;

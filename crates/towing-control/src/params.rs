@@ -456,7 +456,7 @@ pub static PARAMETERS: &[Parameter] = &[
     Parameter {
         name: "admm.rho",
         old_name: Some("rho"),
-        description: "ADMM penalty rho of eq. (22), per m^2 of position and per rad^2 of heading residual; not given by the paper, 20 chosen by measurement (towing-mpc rho_sweep, docs/assumptions.md)",
+        description: "ADMM penalty rho of eq. (22), per m^2 of position and per rad^2 of heading residual; not given by the paper, 10 chosen by measurement (the paper scenario's distributed runs under small perturbations, docs/assumptions.md)",
         kind: Kind::Real {
             unit: "1/m2",
             min: Limit::AtLeast(0.0),

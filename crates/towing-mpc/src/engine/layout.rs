@@ -1,13 +1,18 @@
-//! The QPs of one subproblem: one per number of soft-row slots per sample in
-//! use, built at construction and updated in place.
+//! The QPs of one subproblem: one per combination of soft-row slots per sample
+//! (block by block) in use, built when a step first needs it and updated in place
+//! afterwards.
 //!
 //! Variables: the increments, then each block's slacks in block order. Rows: two
 //! box rows per increment (`2 j`: `x_j <= hi_j`, `2 j + 1`: `-x_j <= -lo_j`) and
 //! per boxed slack, then the rate rows, then each block's rows. `P` is dense over the increments and
-//! zero over the slacks. A step uses the smallest layout that holds the slots
-//! recorded (an unused slot is a row `-s <= 0` on a slack of positive cost: its
-//! slack is zero at the optimum, so a layout without it has the same solution in
-//! the increments, and fewer rows).
+//! zero over the slacks. A step uses the smallest layout that holds the rows
+//! recorded, each block with as many rows per sample as its busiest sample has
+//! active rows ([`super::SlotRows::compact`]; an unused slot would be a row
+//! `-s <= 0` on a slack of positive cost: its slack is zero at the optimum, so a
+//! layout without it has the same solution in the increments, and fewer rows and
+//! variables). A layout built late gives the same bits as one built early: the QP's
+//! structure and initial values, hence Clarabel's equilibration, depend on the
+//! combination alone, and no solve carries anything to the next.
 
 use super::quad::QuadModel;
 use super::rows::{self, set_box, BlockLayout, RowSet};
@@ -24,8 +29,12 @@ pub(crate) struct Layout {
 }
 
 impl Layout {
-    /// The layout of `rows` with `slots` slots per sample.
-    fn new(space: &InputSpace, rows: &impl RowSet, slots: usize) -> Result<Layout, QpBuildError> {
+    /// The layout of `rows` with `slots[b]` slots per sample in block `b`.
+    fn new(
+        space: &InputSpace,
+        rows: &impl RowSet,
+        slots: &[usize],
+    ) -> Result<Layout, QpBuildError> {
         let n_u = space.len();
         let rate = space.rate_entries(0);
         let n_rate = rate.len();
@@ -77,25 +86,44 @@ impl Layout {
     }
 }
 
-/// The layouts of a subproblem, by slots per sample, and the one last used.
+/// Layouts kept at most: a combination met again after its layout was dropped is
+/// built again, with the same bits (module docs). A run meets a few dozen
+/// combinations (the paper scenario 12 centralized).
+const MAX_LAYOUTS: usize = 64;
+
+/// The layouts of a subproblem met so far, by slots per sample of each block, most
+/// recently used last, and the key of the step being loaded.
 #[derive(Debug)]
 pub(crate) struct Layouts {
-    layouts: Vec<Layout>,
-    used: usize,
+    layouts: Vec<(Vec<usize>, Layout)>,
+    key: Vec<usize>,
 }
 
 impl Layouts {
-    /// One layout per slot count `0..=rows.max_slots()`.
+    /// The layout with every slot of every block (which checks that the QPs of
+    /// `rows` can be built) and the one without soft rows.
     pub(crate) fn new(space: &InputSpace, rows: &impl RowSet) -> Result<Layouts, QpBuildError> {
-        let layouts = (0..=rows.max_slots())
-            .map(|c| Layout::new(space, rows, c))
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok(Layouts { layouts, used: 0 })
+        let full = rows::full_slots(rows);
+        let none = vec![0; full.len()];
+        let mut layouts = Vec::with_capacity(MAX_LAYOUTS);
+        for key in [none, full] {
+            let layout = Layout::new(space, rows, &key)?;
+            layouts.push((key, layout));
+        }
+        Ok(Layouts {
+            layouts,
+            key: Vec::new(),
+        })
     }
 
     /// Loads one step: drops the soft rows the boxes `[lo, hi]` imply, picks the
-    /// smallest layout holding the rest and writes the quadratic model, the
+    /// smallest layout holding the rest (built if not met before, the least recently
+    /// used one dropped beyond [`MAX_LAYOUTS`]) and writes the quadratic model, the
     /// boxes, the rate rows (from `plan`) and the soft rows into it.
+    ///
+    /// # Errors
+    /// A layout that cannot be built (not expected: its structure is a part of the
+    /// full layout's, built at construction).
     pub(crate) fn load(
         &mut self,
         space: &InputSpace,
@@ -104,9 +132,21 @@ impl Layouts {
         plan: &[f64],
         lo: &[f64],
         hi: &[f64],
-    ) -> &mut Layout {
-        self.used = rows::prune(rows, lo, hi).min(self.layouts.len() - 1);
-        let layout = &mut self.layouts[self.used];
+    ) -> Result<&mut Layout, QpBuildError> {
+        rows::prune(rows, lo, hi, &mut self.key);
+        let found = self.layouts.iter().rposition(|(k, _)| *k == self.key);
+        let entry = match found {
+            Some(i) => self.layouts.remove(i),
+            None => {
+                if self.layouts.len() >= MAX_LAYOUTS {
+                    self.layouts.remove(0);
+                }
+                (self.key.clone(), Layout::new(space, rows, &self.key)?)
+            }
+        };
+        self.layouts.push(entry);
+        let last = self.layouts.len() - 1;
+        let layout = &mut self.layouts[last].1;
         let qp = &mut layout.qp;
         let n = quad.g.len();
         qp.p_mut().copy_from_slice(&quad.p);
@@ -117,12 +157,12 @@ impl Layouts {
             set_box(qp, j, l, h);
         }
         space.load_rate_rows(qp, layout.rate_row, plan);
-        layout
+        Ok(layout)
     }
 
     /// The last solution of the layout last loaded (increments then slacks).
     pub(crate) fn solution(&self) -> &[f64] {
-        self.layouts[self.used].qp().solution()
+        self.layouts.last().map_or(&[], |(_, l)| l.qp().solution())
     }
 }
 

@@ -50,7 +50,7 @@ pub(crate) use layout::Layouts;
 
 use nalgebra::{Matrix6, SMatrix};
 
-use crate::qp::{QpBuildError, QpOutcome};
+use crate::qp::{QpBuildError, QpFailure, QpOutcome};
 
 /// Condensing (state elimination) of a linearised horizon: with
 /// `x_{h+1} = A_h x_h + B_h u_h`, the sensitivity of the predicted state `h` to
@@ -122,7 +122,7 @@ impl ScpReport {
 
     /// A step that never ran (a report slot before the first step).
     pub(crate) fn never_run() -> ScpReport {
-        ScpReport::rejected(QpOutcome::Failed(crate::QpFailure::Other), f64::NAN, 0.0, 0)
+        ScpReport::rejected(QpOutcome::Failed(QpFailure::Other), f64::NAN, 0.0, 0)
     }
 }
 
@@ -432,7 +432,7 @@ impl<P: Subproblem> Scp<P> {
             &mut self.hi,
         );
         let (outcome, iterations, predicted) = {
-            let layout = self.layouts.load(
+            let loaded = self.layouts.load(
                 space,
                 &mut self.rows,
                 &self.quad,
@@ -440,7 +440,11 @@ impl<P: Subproblem> Scp<P> {
                 &self.lo,
                 &self.hi,
             );
-            match layout.solve(&self.rows, &self.quad, n_u) {
+            let solved = match loaded {
+                Ok(layout) => layout.solve(&self.rows, &self.quad, n_u),
+                Err(_) => Err((QpOutcome::Failed(QpFailure::Other), 0)),
+            };
+            match solved {
                 Ok(solved) => solved,
                 Err((outcome, iterations)) => {
                     self.trust.fail();

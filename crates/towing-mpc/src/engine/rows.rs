@@ -121,6 +121,11 @@ pub struct SlotRows {
     bound: Vec<f64>,
     grad: Vec<f64>,
     active: Vec<bool>,
+    /// Per sample (`h slots ..`), the slots in layout order: the active ones
+    /// first, in slot order, then the others ([`SlotRows::compact`]).
+    order: Vec<usize>,
+    /// The most active rows of any sample, as of the last [`SlotRows::compact`].
+    used: usize,
 }
 
 impl SlotRows {
@@ -148,6 +153,8 @@ impl SlotRows {
             bound: vec![0.0; n],
             grad: vec![0.0; n * n_u],
             active: vec![false; n],
+            order: (0..n).map(|k| k % slots.max(1)).collect(),
+            used: 0,
         }
     }
 
@@ -200,21 +207,39 @@ impl SlotRows {
         }
     }
 
-    /// Slots per sample in use: one more than the highest slot recorded (and
-    /// still active) at any sample; 0 if none.
+    /// Orders each sample's slots, the active ones first, so that a layout with
+    /// as many rows per sample as the busiest sample has active rows holds them
+    /// all ([`SlotRows::slots_used`]): which slot a row was recorded in does not
+    /// matter to the QP.
+    pub fn compact(&mut self) {
+        let m = self.slots;
+        self.used = 0;
+        for h in 0..self.horizon {
+            let range = h * m..(h + 1) * m;
+            let active = &self.active[range.clone()];
+            let order = &mut self.order[range];
+            let mut next = 0;
+            for first in [true, false] {
+                for j in (0..m).filter(|&j| active[j] == first) {
+                    order[next] = j;
+                    next += 1;
+                }
+            }
+            self.used = self.used.max(active.iter().filter(|&&a| a).count());
+        }
+    }
+
+    /// Rows per sample in use: the most active rows of any sample, as of the last
+    /// [`SlotRows::compact`]; 0 if none.
     #[must_use]
     pub fn slots_used(&self) -> usize {
-        let m = self.slots;
-        (0..self.active.len())
-            .filter(|&k| self.active[k])
-            .map(|k| k % m + 1)
-            .max()
-            .unwrap_or(0)
+        self.used
     }
 
     /// The recorded row behind layout row `k` of a layout with `m` slots.
     fn source(&self, m: usize, k: usize) -> usize {
-        (k / m) * self.slots + k % m
+        let h = k / m;
+        h * self.slots + self.order[h * self.slots + k % m]
     }
 
     /// One row per layout row, its slack boxed.
@@ -419,17 +444,6 @@ pub trait RowSet: std::fmt::Debug {
             }
         }
     }
-
-    /// The largest number of slots per sample of any one-sided block.
-    fn max_slots(&self) -> usize {
-        self.blocks()
-            .map(|b| match b {
-                Block::Slots(s) => s.slots(),
-                Block::Pairs(_) => 0,
-            })
-            .max()
-            .unwrap_or(0)
-    }
 }
 
 /// A block placed in one QP: first row (after the boxes), first slack, slots,
@@ -457,12 +471,13 @@ pub(crate) struct Placement {
     pub variables: usize,
 }
 
-/// The layout of every block of `rows` in a QP with `slots` slots per sample,
-/// its rows from extra row `first_row` and its slacks from variable
-/// `first_slack` on (the increments `0..first_slack` are boxed).
+/// The layout of every block of `rows` in a QP with `slots[b]` slots per sample
+/// for block `b` (ignored for two-sided blocks), its rows from extra row
+/// `first_row` and its slacks from variable `first_slack` on (the increments
+/// `0..first_slack` are boxed).
 pub(crate) fn layout_entries(
     rows: &impl RowSet,
-    slots: usize,
+    slots: &[usize],
     reach: Reach<'_>,
     mut first_row: usize,
     mut first_slack: usize,
@@ -470,7 +485,7 @@ pub(crate) fn layout_entries(
     let mut entries = Vec::new();
     let mut boxed: Vec<usize> = (0..first_slack).collect();
     let mut blocks = Vec::new();
-    for block in rows.blocks() {
+    for (block, &slots) in rows.blocks().zip(slots) {
         let e = match block {
             Block::Slots(s) => s.entries(slots, reach, first_row, first_slack),
             Block::Pairs(p) => p.entries(reach, first_row, first_slack),
@@ -522,17 +537,30 @@ impl Placement {
     }
 }
 
-/// Drops the one-sided rows the boxes imply; returns the slots per sample the
-/// step needs (the layout to use).
-pub(crate) fn prune(rows: &mut impl RowSet, lo: &[f64], hi: &[f64]) -> usize {
-    let mut used = 0;
+/// Drops the one-sided rows the boxes imply and writes, per block, the slots per
+/// sample the step needs (0 for two-sided blocks) into `used`: the layout to use.
+pub(crate) fn prune(rows: &mut impl RowSet, lo: &[f64], hi: &[f64], used: &mut Vec<usize>) {
+    used.clear();
     for b in rows.blocks_mut() {
-        if let BlockMut::Slots(s) = b {
-            s.drop_redundant(lo, hi);
-            used = used.max(s.slots_used());
-        }
+        used.push(match b {
+            BlockMut::Slots(s) => {
+                s.drop_redundant(lo, hi);
+                s.compact();
+                s.slots_used()
+            }
+            BlockMut::Pairs(_) => 0,
+        });
     }
-    used
+}
+
+/// Per block, the most slots per sample it can use (0 for two-sided blocks).
+pub(crate) fn full_slots(rows: &impl RowSet) -> Vec<usize> {
+    rows.blocks()
+        .map(|b| match b {
+            Block::Slots(s) => s.slots(),
+            Block::Pairs(_) => 0,
+        })
+        .collect()
 }
 
 /// Writes every block's rows into `qp` (the layouts of that QP).
@@ -564,5 +592,43 @@ pub(crate) fn add_predicted_decrease(
         if let Block::Pairs(p) = block {
             p.add_predicted_decrease(&x[..n_u], acc);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The active rows of each sample come first, in slot order, and the busiest
+    /// sample sets the rows per sample a layout needs; a row dropped as implied by
+    /// the boxes no longer counts.
+    #[test]
+    fn compact_puts_each_samples_active_rows_first() {
+        let (slots, horizon, per_step) = (4, 3, 2);
+        let mut rows = SlotRows::new(slots, (horizon, per_step), 1, 1e4, 10.0);
+        let n_u = per_step * horizon;
+        let row = |c: f64| vec![c; n_u];
+        rows.record(0, 3, 0.0, 1.0, &row(1.0));
+        rows.record(1, 1, 0.0, 1.0, &row(1.0));
+        rows.record(1, 2, 0.0, 1.0, &row(1.0));
+        rows.compact();
+        assert_eq!(rows.slots_used(), 2);
+        // Layout of 2 rows per sample: row k of sample h is the recorded slot below.
+        let m = 2;
+        assert_eq!(rows.source(m, 0), 3);
+        assert_eq!(rows.source(m, 2), slots + 1);
+        assert_eq!(rows.source(m, 3), slots + 2);
+        assert!(rows.active[rows.source(m, 0)] && !rows.active[rows.source(m, 1)]);
+        assert!((4..6).all(|k| !rows.active[rows.source(m, k)]));
+        // A box that implies slot 3 of sample 0 (its bound met for every increment
+        // in it) leaves sample 1 alone the busiest.
+        rows.record(0, 3, 2.0, 1.0, &row(0.0));
+        rows.drop_redundant(&[-1.0; 6], &[1.0; 6]);
+        rows.compact();
+        assert_eq!(rows.slots_used(), 2);
+        assert!(!rows.active[3]);
+        rows.clear();
+        rows.compact();
+        assert_eq!(rows.slots_used(), 0);
     }
 }
