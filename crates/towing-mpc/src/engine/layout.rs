@@ -86,16 +86,19 @@ impl Layout {
     }
 }
 
-/// Layouts kept at most: a combination met again after its layout was dropped is
-/// built again, with the same bits (module docs). A run meets a few dozen
+/// Layouts kept at most (the least recently used one is replaced): a combination met
+/// again after its layout was dropped is built again, with the same bits (module docs). A run meets a few dozen
 /// combinations (the paper scenario 12 centralized).
 const MAX_LAYOUTS: usize = 64;
 
-/// The layouts of a subproblem met so far, by slots per sample of each block, most
-/// recently used last, and the key of the step being loaded.
+/// The layouts of a subproblem met so far, by slots per sample of each block, with
+/// the step each was last used at; the one last loaded, and the key of the step
+/// being loaded.
 #[derive(Debug)]
 pub(crate) struct Layouts {
-    layouts: Vec<(Vec<usize>, Layout)>,
+    layouts: Vec<(Vec<usize>, Layout, u64)>,
+    used: usize,
+    steps: u64,
     key: Vec<usize>,
 }
 
@@ -108,10 +111,12 @@ impl Layouts {
         let mut layouts = Vec::with_capacity(MAX_LAYOUTS);
         for key in [none, full] {
             let layout = Layout::new(space, rows, &key)?;
-            layouts.push((key, layout));
+            layouts.push((key, layout, 0));
         }
         Ok(Layouts {
             layouts,
+            used: 0,
+            steps: 0,
             key: Vec::new(),
         })
     }
@@ -134,19 +139,29 @@ impl Layouts {
         hi: &[f64],
     ) -> Result<&mut Layout, QpBuildError> {
         rows::prune(rows, lo, hi, &mut self.key);
-        let found = self.layouts.iter().rposition(|(k, _)| *k == self.key);
-        let entry = match found {
-            Some(i) => self.layouts.remove(i),
+        self.steps += 1;
+        self.used = match self.layouts.iter().position(|(k, _, _)| *k == self.key) {
+            Some(i) => i,
             None => {
-                if self.layouts.len() >= MAX_LAYOUTS {
-                    self.layouts.remove(0);
+                let entry = (
+                    self.key.clone(),
+                    Layout::new(space, rows, &self.key)?,
+                    self.steps,
+                );
+                if self.layouts.len() < MAX_LAYOUTS {
+                    self.layouts.push(entry);
+                    self.layouts.len() - 1
+                } else {
+                    let oldest = (0..self.layouts.len())
+                        .min_by_key(|&i| self.layouts[i].2)
+                        .unwrap_or(0);
+                    self.layouts[oldest] = entry;
+                    oldest
                 }
-                (self.key.clone(), Layout::new(space, rows, &self.key)?)
             }
         };
-        self.layouts.push(entry);
-        let last = self.layouts.len() - 1;
-        let layout = &mut self.layouts[last].1;
+        let (_, layout, last_used) = &mut self.layouts[self.used];
+        *last_used = self.steps;
         let qp = &mut layout.qp;
         let n = quad.g.len();
         qp.p_mut().copy_from_slice(&quad.p);
@@ -162,7 +177,7 @@ impl Layouts {
 
     /// The last solution of the layout last loaded (increments then slacks).
     pub(crate) fn solution(&self) -> &[f64] {
-        self.layouts.last().map_or(&[], |(_, l)| l.qp().solution())
+        self.layouts[self.used].1.qp().solution()
     }
 }
 

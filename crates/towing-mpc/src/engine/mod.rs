@@ -399,7 +399,8 @@ impl<P: Subproblem> Scp<P> {
             .terms(&mut self.quad, &self.traj, &self.plan, None, data)
     }
 
-    /// One SCP step (module docs). Allocation-free.
+    /// One SCP step (module docs). Allocation-free once its QP layout exists (a
+    /// combination of soft rows met for the first time builds one).
     pub fn step(&mut self, data: &P::Data<'_>) -> ScpReport {
         let space = self.problem.space();
         let n_u = space.len();
