@@ -124,8 +124,6 @@ pub struct SlotRows {
     /// Per sample (`h slots ..`), the slots in layout order: the active ones
     /// first, in slot order, then the others ([`SlotRows::compact`]).
     order: Vec<usize>,
-    /// The most active rows of any sample, as of the last [`SlotRows::compact`].
-    used: usize,
 }
 
 impl SlotRows {
@@ -154,7 +152,6 @@ impl SlotRows {
             grad: vec![0.0; n * n_u],
             active: vec![false; n],
             order: (0..n).map(|k| k % slots.max(1)).collect(),
-            used: 0,
         }
     }
 
@@ -213,7 +210,6 @@ impl SlotRows {
     /// matter to the QP.
     pub fn compact(&mut self) {
         let m = self.slots;
-        self.used = 0;
         for h in 0..self.horizon {
             let range = h * m..(h + 1) * m;
             let active = &self.active[range.clone()];
@@ -225,15 +221,17 @@ impl SlotRows {
                     next += 1;
                 }
             }
-            self.used = self.used.max(active.iter().filter(|&&a| a).count());
         }
     }
 
-    /// Rows per sample in use: the most active rows of any sample, as of the last
-    /// [`SlotRows::compact`]; 0 if none.
+    /// Rows per sample in use: the most active rows of any sample; 0 if none.
     #[must_use]
     pub fn slots_used(&self) -> usize {
-        self.used
+        self.active
+            .chunks(self.slots.max(1))
+            .map(|sample| sample.iter().filter(|&&a| a).count())
+            .max()
+            .unwrap_or(0)
     }
 
     /// The recorded row behind layout row `k` of a layout with `m` slots.
