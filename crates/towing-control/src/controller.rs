@@ -691,7 +691,7 @@ impl Controller {
         .reduce(f64::min);
         let heading_floor = self.heading_floor(m);
         let reference = self.reference(
-            &m.ship,
+            m,
             (guidance.active_waypoint, target),
             altered,
             lookahead,
@@ -861,12 +861,13 @@ impl Controller {
     /// is farther than `los_distance`, else the point's route heading.
     fn reference(
         &mut self,
-        ship: &[f64; 6],
+        m: &Measurement,
         (active, target): (usize, Pose),
         altered: bool,
         lookahead: f64,
         floor: Option<f64>,
     ) -> [f64; 3] {
+        let ship = &m.ship;
         let points = self.guidance.route().points();
         let last = points.len() - 1;
         let mut goal = target.eta();
@@ -898,7 +899,112 @@ impl Controller {
                 }
             }
         }
-        self.steer(ship, goal, floor)
+        let leg = (points[active - 1].position(), points[active].position());
+        let goal = self.clear_of_hazards(ship, goal, leg, &m.obstacles);
+        let reference = self.steer(ship, goal, floor);
+        self.short_of_hazards(ship, reference, &m.obstacles)
+    }
+
+    /// The static hazards of `obstacles`, each as its centre and the ship's hazard
+    /// safe range from it (eq. (14): `L + R + d_S0`, 2.005 m for the paper's ship and
+    /// hazards).
+    fn hazard_circles<'a>(
+        &self,
+        obstacles: &'a [ObstacleSlot],
+    ) -> impl Iterator<Item = ([f64; 2], f64)> + 'a {
+        let g = self.guidance.params().settings();
+        let own = g.ship_length + g.safety_buffer;
+        obstacles
+            .iter()
+            .filter(|o| o.kind == ObstacleKind::StaticCircle)
+            .map(move |o| ([o.x, o.y], own + 0.5 * o.length.max(o.width)))
+    }
+
+    /// The tracked position of `reference` brought back along the line from the
+    /// ship to where that line first comes within a hazard's safe range (or to the
+    /// ship, inside one): the reference course, limited in its rate and its lead
+    /// over the ship's heading ([`Controller::steer`]), may still point at a hazard
+    /// the line of sight turns away from ([`Controller::clear_of_hazards`]), and a
+    /// tracked position beyond the hazard held the tow against it, her forward tug
+    /// kept off by the clearance rows (random-12-0047: a 1000 s stall). Short of
+    /// the hazard the heading term turns her first, as a seaman turns before going
+    /// on past a danger close ahead.
+    fn short_of_hazards(
+        &self,
+        ship: &[f64; 6],
+        mut reference: [f64; 3],
+        obstacles: &[ObstacleSlot],
+    ) -> [f64; 3] {
+        for (centre, rho) in self.hazard_circles(obstacles) {
+            let (sx, sy) = (reference[0] - ship[0], reference[1] - ship[1]);
+            let (cx, cy) = (centre[0] - ship[0], centre[1] - ship[1]);
+            // |s t - c| = rho: t^2 |s|^2 - 2 t s.c + |c|^2 - rho^2 = 0, first root in [0, 1].
+            let (a, b, c) = (
+                sx * sx + sy * sy,
+                sx * cx + sy * cy,
+                cx * cx + cy * cy - rho * rho,
+            );
+            let disc = b * b - a * c;
+            if a <= 0.0 || disc < 0.0 {
+                continue;
+            }
+            let t = if c <= 0.0 { 0.0 } else { (b - disc.sqrt()) / a };
+            if (0.0..1.0).contains(&t) {
+                reference[0] = ship[0] + t * sx;
+                reference[1] = ship[1] + t * sy;
+            }
+        }
+        reference
+    }
+
+    /// The tracked point `goal` moved so that the line of sight from the ship to it
+    /// keeps clear of every static hazard (`docs/colregs.md`, "Static hazards": the
+    /// line of sight passes a hazard clear). A hazard whose circle of the ship's
+    /// hazard safe range ([`Controller::hazard_circles`]) cuts the segment from the ship to `goal` turns the line of
+    /// sight, at the same range, onto the tangent from the ship to that circle on the
+    /// side the route `leg` (start, end) passes the hazard (the port tangent for a
+    /// hazard to starboard of the leg), or onto the circle's direction when the ship
+    /// is already inside it. Without it the tracked point came to lie on a hazard
+    /// beside a turn and the tow stalled beside it, its forward tug held off the
+    /// hazard by the clearance rows while the position term pulled it on (issue's
+    /// stall mode; random-12-0047: 1000 s). A tangent line of sight is the
+    /// classical way round a circular obstacle (Fossen 2011, section 10.3.2 for
+    /// the line of sight; the tangent as in the "tangent bug" of Kamon, Rivlin and
+    /// Rimon 1998, "TangentBug", Int. J. Robotics Research 17(9)).
+    fn clear_of_hazards(
+        &self,
+        ship: &[f64; 6],
+        mut goal: [f64; 3],
+        (start, end): ([f64; 2], [f64; 2]),
+        obstacles: &[ObstacleSlot],
+    ) -> [f64; 3] {
+        let e = [end[0] - start[0], end[1] - start[1]];
+        for (centre, rho) in self.hazard_circles(obstacles) {
+            let (sx, sy) = (goal[0] - ship[0], goal[1] - ship[1]);
+            let (cx, cy) = (centre[0] - ship[0], centre[1] - ship[1]);
+            let reach2 = sx * sx + sy * sy;
+            if reach2 <= 0.0 {
+                continue;
+            }
+            let t = ((cx * sx + cy * sy) / reach2).clamp(0.0, 1.0);
+            if (cx - t * sx).hypot(cy - t * sy) >= rho {
+                continue;
+            }
+            // The side the route passes the hazard: to starboard of the leg (NED,
+            // x north, y east: e x w > 0), it is passed on the port hand.
+            let starboard = e[0] * (centre[1] - start[1]) - e[1] * (centre[0] - start[0]) >= 0.0;
+            let range = cx.hypot(cy);
+            let off = if range > rho {
+                (rho / range).asin()
+            } else {
+                std::f64::consts::FRAC_PI_2
+            };
+            let bearing = wrap_angle(cy.atan2(cx) + if starboard { -off } else { off });
+            let reach = reach2.sqrt();
+            let (sin, cos) = bearing.sin_cos();
+            goal = [ship[0] + reach * cos, ship[1] + reach * sin, bearing];
+        }
+        goal
     }
 
     /// The reference pose the MPC tracks, from the tracked point `goal`

@@ -631,3 +631,66 @@ fn step_samples_on_its_own_clock() {
     let e = c.step(t, &bad).unwrap_err();
     assert!(e.to_string().contains("tug2.v"), "{e}");
 }
+
+/// A static hazard 2.5 m ahead on the first leg, 1 m to one side of it, the ship at rest
+/// on the route and alone with it: the line of sight to the tracked point (3.5 m along
+/// the leg) passes 1 m from the hazard, inside the ship's hazard safe range (eq. (14),
+/// 2.005 m). The reference course turns away from the hazard, to the side of it the
+/// route lies on (to port for a hazard to starboard of the leg, to starboard for one to
+/// port), and the tracked point lies short of the hazard's safe range on that course.
+#[test]
+fn a_hazard_on_the_line_of_sight_turns_the_reference_away_and_holds_the_point_short() {
+    let (scenario, mut m) = paper_measurement();
+    let config = ControllerConfig::new(scenario);
+    let step = config.tuning.tracking.course_rate * config.tuning.prediction.sample_time;
+    let lookahead = config.tuning.tracking.lookahead;
+    let psi = m.ship[2];
+    // The first leg's course (101.3 deg), within one course step of the ship's heading.
+    let leg = (14.0f64 - 7.0).atan2(-6.3 + 4.9);
+    let rho = 1.255 + 0.5 + 0.25;
+    for o in m.obstacles.iter_mut() {
+        o.kind = ObstacleKind::None;
+    }
+    for side in [1.0, -1.0] {
+        // `side` 1: to starboard of the leg (starboard of a course is course + 90 deg).
+        let (s, c) = leg.sin_cos();
+        let hazard = [
+            m.ship[0] + 2.5 * c - side * 1.0 * s,
+            m.ship[1] + 2.5 * s + side * 1.0 * c,
+        ];
+        let mut with = m;
+        with.obstacles[0] = ObstacleSlot {
+            x: hazard[0],
+            y: hazard[1],
+            psi: 0.0,
+            speed: 0.0,
+            length: 1.0,
+            width: 1.0,
+            kind: ObstacleKind::StaticCircle,
+        };
+        let mut c = Controller::new(config.clone()).unwrap();
+        let r = c.sample(&with).unwrap().reference;
+        let turn = towing_model::wrap_angle(r[2] - psi);
+        assert!(
+            (turn + side * step).abs() < 1e-9,
+            "side {side}: turned {turn} rad, expected {} rad",
+            -side * step
+        );
+        let (dx, dy) = (r[0] - m.ship[0], r[1] - m.ship[1]);
+        let reach = dx.hypot(dy);
+        let clear = (r[0] - hazard[0]).hypot(r[1] - hazard[1]);
+        assert!(
+            reach < lookahead - 1.0,
+            "side {side}: point {reach} m ahead"
+        );
+        assert!(
+            (clear - rho).abs() < 1e-9,
+            "side {side}: point {clear} m from the hazard"
+        );
+        // Without the hazard: along the leg, the whole lookahead ahead.
+        let mut free = Controller::new(config.clone()).unwrap();
+        let r = free.sample(&m).unwrap().reference;
+        assert!(towing_model::wrap_angle(r[2] - leg).abs() < 1e-9);
+        assert!(((r[0] - m.ship[0]).hypot(r[1] - m.ship[1]) - lookahead).abs() < 1e-9);
+    }
+}
