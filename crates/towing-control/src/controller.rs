@@ -926,9 +926,9 @@ impl Controller {
     /// over the ship's heading ([`Controller::steer`]), may still point at a hazard
     /// the line of sight turns away from ([`Controller::clear_of_hazards`]), and a
     /// tracked position beyond the hazard held the tow against it, her forward tug
-    /// kept off by the clearance rows (random-12-0047: a 1000 s stall). Short of
-    /// the hazard the heading term turns her first, as a seaman turns before going
-    /// on past a danger close ahead.
+    /// kept off by the clearance rows (the issue's stall mode). Short of the hazard
+    /// the heading term turns her first, as a seaman turns before going on past a
+    /// danger close ahead.
     fn short_of_hazards(
         &self,
         ship: &[f64; 6],
@@ -960,14 +960,16 @@ impl Controller {
     /// The tracked point `goal` moved so that the line of sight from the ship to it
     /// keeps clear of every static hazard (`docs/colregs.md`, "Static hazards": the
     /// line of sight passes a hazard clear). A hazard whose circle of the ship's
-    /// hazard safe range ([`Controller::hazard_circles`]) cuts the segment from the ship to `goal` turns the line of
-    /// sight, at the same range, onto the tangent from the ship to that circle on the
-    /// side the route `leg` (start, end) passes the hazard (the port tangent for a
-    /// hazard to starboard of the leg), or onto the circle's direction when the ship
-    /// is already inside it. Without it the tracked point came to lie on a hazard
-    /// beside a turn and the tow stalled beside it, its forward tug held off the
-    /// hazard by the clearance rows while the position term pulled it on (issue's
-    /// stall mode; random-12-0047: 1000 s). A tangent line of sight is the
+    /// hazard safe range ([`Controller::hazard_circles`]) cuts the segment from the
+    /// ship to `goal` turns the line of sight, at the same range, onto the tangent
+    /// from the ship to that circle on the side the route `leg` (start, end) passes
+    /// the hazard (the port tangent for a hazard to starboard of the leg), or, when
+    /// the ship is already inside the circle, square to the line to its centre on
+    /// that side. Without it the tracked point came to lie on a hazard beside a
+    /// turn and the tow was held against it, its forward tug kept off the hazard by
+    /// the clearance rows while the position term pulled it on (the issue's stall
+    /// mode; measured in `docs/assumptions.md`, row "line of sight clear of
+    /// hazards"). A tangent line of sight is the
     /// classical way round a circular obstacle (Fossen 2011, section 10.3.2 for
     /// the line of sight; the tangent as in the "tangent bug" of Kamon, Rivlin and
     /// Rimon 1998, "TangentBug", Int. J. Robotics Research 17(9)).
