@@ -921,8 +921,8 @@ impl Controller {
     }
 
     /// The tracked position of `reference` brought back along the line from the
-    /// ship to where that line first comes within a hazard's safe range (or to the
-    /// ship, inside one): the reference course, limited in its rate and its lead
+    /// ship to where that line first comes within a hazard's safe range (not for a
+    /// circle the ship is already inside): the reference course, limited in its rate and its lead
     /// over the ship's heading ([`Controller::steer`]), may still point at a hazard
     /// the line of sight turns away from ([`Controller::clear_of_hazards`]), and a
     /// tracked position beyond the hazard held the tow against it, her forward tug
@@ -945,10 +945,13 @@ impl Controller {
                 cx * cx + cy * cy - rho * rho,
             );
             let disc = b * b - a * c;
-            if a <= 0.0 || disc < 0.0 {
+            // Inside the circle already (c <= 0) the point is not held: held at the
+            // ship, the tow stayed inside (the paper scenario's centralized scheme II
+            // lay 55 s at 1.97 m from hazard c); the line of sight leads out.
+            if a <= 0.0 || disc < 0.0 || c <= 0.0 {
                 continue;
             }
-            let t = if c <= 0.0 { 0.0 } else { (b - disc.sqrt()) / a };
+            let t = (b - disc.sqrt()) / a;
             if (0.0..1.0).contains(&t) {
                 reference[0] = ship[0] + t * sx;
                 reference[1] = ship[1] + t * sy;
