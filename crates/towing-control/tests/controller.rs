@@ -694,3 +694,40 @@ fn a_hazard_on_the_line_of_sight_turns_the_reference_away_and_holds_the_point_sh
         assert!(((r[0] - m.ship[0]).hypot(r[1] - m.ship[1]) - lookahead).abs() < 1e-9);
     }
 }
+
+/// The ship already inside a hazard's safe range (the hazard 1 m abeam to starboard of
+/// the leg, its safe range 2.005 m): the tracked point is not held at the ship, which
+/// kept the tow inside; the line of sight leads out, square to the line to the hazard's
+/// centre on the route's side of it (here: ahead along the leg, the whole lookahead).
+#[test]
+fn inside_a_hazards_safe_range_the_tracked_point_is_not_held_at_the_ship() {
+    let (scenario, mut m) = paper_measurement();
+    let config = ControllerConfig::new(scenario);
+    let lookahead = config.tuning.tracking.lookahead;
+    let step = config.tuning.tracking.course_rate * config.tuning.prediction.sample_time;
+    let leg = (14.0f64 - 7.0).atan2(-6.3 + 4.9);
+    for o in m.obstacles.iter_mut() {
+        o.kind = ObstacleKind::None;
+    }
+    let (s, c) = leg.sin_cos();
+    m.obstacles[0] = ObstacleSlot {
+        x: m.ship[0] - s,
+        y: m.ship[1] + c,
+        psi: 0.0,
+        speed: 0.0,
+        length: 1.0,
+        width: 1.0,
+        kind: ObstacleKind::StaticCircle,
+    };
+    let r = Controller::new(config)
+        .unwrap()
+        .sample(&m)
+        .unwrap()
+        .reference;
+    let reach = (r[0] - m.ship[0]).hypot(r[1] - m.ship[1]);
+    assert!(
+        (reach - lookahead).abs() < 1e-9,
+        "point {reach} m from the ship"
+    );
+    assert!(towing_model::wrap_angle(r[2] - leg).abs() <= step + 1e-12);
+}
