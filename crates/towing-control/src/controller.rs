@@ -34,8 +34,8 @@ use std::time::{Duration, Instant};
 use serde::{Deserialize, Serialize};
 
 use towing_guidance::{
-    body_to_ned, role, ActiveObstacle, GuidanceOutput, GuidanceParams, ReferenceSystem, Role,
-    Situation, TowState,
+    body_to_ned, role, segment_distance, ActiveObstacle, GuidanceOutput, GuidanceParams,
+    ReferenceSystem, Role, Situation, TowState,
 };
 use towing_model::geometry::Lane;
 use towing_model::{
@@ -906,29 +906,34 @@ impl Controller {
     }
 
     /// The static hazards of `obstacles`, each as its centre and the ship's hazard
-    /// safe range from it (eq. (14): `L + R + d_S0`, 2.005 m for the paper's ship and
-    /// hazards).
+    /// safe range from it ([`ActiveObstacle::safe_range`], eq. (14): `L + R + d_S0`,
+    /// 2.005 m for the paper's ship and hazards). The slots were checked by the
+    /// guidance's update of this sample.
     fn hazard_circles<'a>(
         &self,
         obstacles: &'a [ObstacleSlot],
     ) -> impl Iterator<Item = ([f64; 2], f64)> + 'a {
         let g = self.guidance.params().settings();
-        let own = g.ship_length + g.safety_buffer;
+        let (own, buffer) = (g.ship_length, g.safety_buffer);
         obstacles
             .iter()
-            .filter(|o| o.kind == ObstacleKind::StaticCircle)
-            .map(move |o| ([o.x, o.y], own + 0.5 * o.length.max(o.width)))
+            .filter_map(move |o| match ActiveObstacle::from_slot(o) {
+                Ok(Some(c @ ActiveObstacle::Circle { .. })) => {
+                    Some((c.centre(), c.safe_range(own, buffer)))
+                }
+                _ => None,
+            })
     }
 
     /// The tracked position of `reference` brought back along the line from the
     /// ship to where that line first comes within a hazard's safe range (not for a
-    /// circle the ship is already inside): the reference course, limited in its rate and its lead
-    /// over the ship's heading ([`Controller::steer`]), may still point at a hazard
-    /// the line of sight turns away from ([`Controller::clear_of_hazards`]), and a
-    /// tracked position beyond the hazard held the tow against it, her forward tug
-    /// kept off by the clearance rows (the issue's stall mode). Short of the hazard
-    /// the heading term turns her first, as a seaman turns before going on past a
-    /// danger close ahead.
+    /// circle the ship is already inside): the reference course, limited in its
+    /// rate and its lead over the ship's heading ([`Controller::steer`]), may
+    /// still point at a hazard the line of sight turns away from
+    /// ([`Controller::clear_of_hazards`]), and a tracked position beyond the
+    /// hazard held the tow against it, her forward tug kept off by the clearance
+    /// rows (the issue's stall mode). Short of the hazard the heading term turns
+    /// her first, as a seaman turns before going on past a danger close ahead.
     fn short_of_hazards(
         &self,
         ship: &[f64; 6],
@@ -972,10 +977,10 @@ impl Controller {
     /// turn and the tow was held against it, its forward tug kept off the hazard by
     /// the clearance rows while the position term pulled it on (the issue's stall
     /// mode; measured in `docs/assumptions.md`, row "line of sight clear of
-    /// hazards"). A tangent line of sight is the
-    /// classical way round a circular obstacle (Fossen 2011, section 10.3.2 for
-    /// the line of sight; the tangent as in the "tangent bug" of Kamon, Rivlin and
-    /// Rimon 1998, "TangentBug", Int. J. Robotics Research 17(9)).
+    /// hazards"). A tangent line of sight is the classical way round a circular
+    /// obstacle (Fossen 2011, section 10.3.2 for the line of sight; the tangent as
+    /// in the "tangent bug" of Kamon, Rivlin and Rimon 1998, "TangentBug", Int. J.
+    /// Robotics Research 17(9)).
     fn clear_of_hazards(
         &self,
         ship: &[f64; 6],
@@ -985,16 +990,13 @@ impl Controller {
     ) -> [f64; 3] {
         let e = [end[0] - start[0], end[1] - start[1]];
         for (centre, rho) in self.hazard_circles(obstacles) {
-            let (sx, sy) = (goal[0] - ship[0], goal[1] - ship[1]);
+            let reach = (goal[0] - ship[0]).hypot(goal[1] - ship[1]);
+            if reach <= 0.0
+                || segment_distance(centre, [ship[0], ship[1]], [goal[0], goal[1]]) >= rho
+            {
+                continue;
+            }
             let (cx, cy) = (centre[0] - ship[0], centre[1] - ship[1]);
-            let reach2 = sx * sx + sy * sy;
-            if reach2 <= 0.0 {
-                continue;
-            }
-            let t = ((cx * sx + cy * sy) / reach2).clamp(0.0, 1.0);
-            if (cx - t * sx).hypot(cy - t * sy) >= rho {
-                continue;
-            }
             // The side the route passes the hazard: to starboard of the leg (NED,
             // x north, y east: e x w > 0), it is passed on the port hand.
             let starboard = e[0] * (centre[1] - start[1]) - e[1] * (centre[0] - start[0]) >= 0.0;
@@ -1005,7 +1007,6 @@ impl Controller {
                 std::f64::consts::FRAC_PI_2
             };
             let bearing = wrap_angle(cy.atan2(cx) + if starboard { -off } else { off });
-            let reach = reach2.sqrt();
             let (sin, cos) = bearing.sin_cos();
             goal = [ship[0] + reach * cos, ship[1] + reach * sin, bearing];
         }

@@ -14,17 +14,36 @@ fn paper_measurement() -> (Scenario, Measurement) {
     (scenario, Measurement::from_world(&world))
 }
 
-/// A static circle of `diameter` centred on the ship.
-fn circle_on_ship(m: &Measurement, diameter: f64) -> ObstacleSlot {
+/// A static circle of `diameter` centred at (`x`, `y`).
+fn circle_at(x: f64, y: f64, diameter: f64) -> ObstacleSlot {
     ObstacleSlot {
-        x: m.ship[0],
-        y: m.ship[1],
+        x,
+        y,
         psi: 0.0,
         speed: 0.0,
         length: diameter,
         width: diameter,
         kind: ObstacleKind::StaticCircle,
     }
+}
+
+/// A static circle of `diameter` centred on the ship.
+fn circle_on_ship(m: &Measurement, diameter: f64) -> ObstacleSlot {
+    circle_at(m.ship[0], m.ship[1], diameter)
+}
+
+/// The paper scenario's first leg course (101.3 deg), from its origin (-4.9, 7.0) to
+/// its first waypoint (-6.3, 14.0).
+fn first_leg_course() -> f64 {
+    (14.0f64 - 7.0).atan2(-6.3 + 4.9)
+}
+
+/// `m` with every obstacle slot empty.
+fn alone(mut m: Measurement) -> Measurement {
+    for o in m.obstacles.iter_mut() {
+        o.kind = ObstacleKind::None;
+    }
+    m
 }
 
 fn assert_within_bounds(c: &towing_control::Command, config: &ControllerConfig) {
@@ -220,7 +239,7 @@ fn the_lookahead_point_lies_ahead_on_the_leg_and_the_heading_looks_at_it() {
     let mut c = Controller::new(ControllerConfig::new(scenario.clone())).unwrap();
     let r = c.sample(&m).unwrap();
     // At the origin, on the route: `lookahead` along the first leg (course 101.3 deg).
-    let course = (14.0f64 - 7.0).atan2(-6.3 + 4.9);
+    let course = first_leg_course();
     let ahead = ControllerConfig::new(scenario.clone())
         .tuning
         .tracking
@@ -640,17 +659,23 @@ fn step_samples_on_its_own_clock() {
 /// port), and the tracked point lies short of the hazard's safe range on that course.
 #[test]
 fn a_hazard_on_the_line_of_sight_turns_the_reference_away_and_holds_the_point_short() {
-    let (scenario, mut m) = paper_measurement();
+    let (scenario, m) = paper_measurement();
+    let m = alone(m);
     let config = ControllerConfig::new(scenario);
     let step = config.tuning.tracking.course_rate * config.tuning.prediction.sample_time;
     let lookahead = config.tuning.tracking.lookahead;
     let psi = m.ship[2];
-    // The first leg's course (101.3 deg), within one course step of the ship's heading.
-    let leg = (14.0f64 - 7.0).atan2(-6.3 + 4.9);
+    // The first leg's course, within one course step of the ship's heading.
+    let leg = first_leg_course();
     let rho = 1.255 + 0.5 + 0.25;
-    for o in m.obstacles.iter_mut() {
-        o.kind = ObstacleKind::None;
-    }
+    // Without the hazard: along the leg, the whole lookahead ahead.
+    let free = Controller::new(config.clone())
+        .unwrap()
+        .sample(&m)
+        .unwrap()
+        .reference;
+    assert!(towing_model::wrap_angle(free[2] - leg).abs() < 1e-9);
+    assert!(((free[0] - m.ship[0]).hypot(free[1] - m.ship[1]) - lookahead).abs() < 1e-9);
     for side in [1.0, -1.0] {
         // `side` 1: to starboard of the leg (starboard of a course is course + 90 deg).
         let (s, c) = leg.sin_cos();
@@ -659,15 +684,7 @@ fn a_hazard_on_the_line_of_sight_turns_the_reference_away_and_holds_the_point_sh
             m.ship[1] + 2.5 * s + side * 1.0 * c,
         ];
         let mut with = m;
-        with.obstacles[0] = ObstacleSlot {
-            x: hazard[0],
-            y: hazard[1],
-            psi: 0.0,
-            speed: 0.0,
-            length: 1.0,
-            width: 1.0,
-            kind: ObstacleKind::StaticCircle,
-        };
+        with.obstacles[0] = circle_at(hazard[0], hazard[1], 1.0);
         let mut c = Controller::new(config.clone()).unwrap();
         let r = c.sample(&with).unwrap().reference;
         let turn = towing_model::wrap_angle(r[2] - psi);
@@ -687,11 +704,6 @@ fn a_hazard_on_the_line_of_sight_turns_the_reference_away_and_holds_the_point_sh
             (clear - rho).abs() < 1e-9,
             "side {side}: point {clear} m from the hazard"
         );
-        // Without the hazard: along the leg, the whole lookahead ahead.
-        let mut free = Controller::new(config.clone()).unwrap();
-        let r = free.sample(&m).unwrap().reference;
-        assert!(towing_model::wrap_angle(r[2] - leg).abs() < 1e-9);
-        assert!(((r[0] - m.ship[0]).hypot(r[1] - m.ship[1]) - lookahead).abs() < 1e-9);
     }
 }
 
@@ -701,24 +713,14 @@ fn a_hazard_on_the_line_of_sight_turns_the_reference_away_and_holds_the_point_sh
 /// centre on the route's side of it (here: ahead along the leg, the whole lookahead).
 #[test]
 fn inside_a_hazards_safe_range_the_tracked_point_is_not_held_at_the_ship() {
-    let (scenario, mut m) = paper_measurement();
+    let (scenario, m) = paper_measurement();
+    let mut m = alone(m);
     let config = ControllerConfig::new(scenario);
     let lookahead = config.tuning.tracking.lookahead;
     let step = config.tuning.tracking.course_rate * config.tuning.prediction.sample_time;
-    let leg = (14.0f64 - 7.0).atan2(-6.3 + 4.9);
-    for o in m.obstacles.iter_mut() {
-        o.kind = ObstacleKind::None;
-    }
+    let leg = first_leg_course();
     let (s, c) = leg.sin_cos();
-    m.obstacles[0] = ObstacleSlot {
-        x: m.ship[0] - s,
-        y: m.ship[1] + c,
-        psi: 0.0,
-        speed: 0.0,
-        length: 1.0,
-        width: 1.0,
-        kind: ObstacleKind::StaticCircle,
-    };
+    m.obstacles[0] = circle_at(m.ship[0] - s, m.ship[1] + c, 1.0);
     let r = Controller::new(config)
         .unwrap()
         .sample(&m)

@@ -87,7 +87,7 @@ pub(crate) fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
 
 /// Distance (m) from `p` to the segment `a`-`b`.
 #[must_use]
-pub(crate) fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+pub fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let d = [b[0] - a[0], b[1] - a[1]];
     let dd = d[0] * d[0] + d[1] * d[1];
     if dd == 0.0 {

@@ -57,7 +57,7 @@ pub use colregs::{
 };
 pub use distance::{ActiveObstacle, Ellipse};
 pub use error::{InputError, ParamError};
-pub use geometry::{body_to_ned, cpa, relative_bearing, wrap_angle, Cpa};
+pub use geometry::{body_to_ned, cpa, relative_bearing, segment_distance, wrap_angle, Cpa};
 pub use params::{GuidanceParams, GuidanceSettings, StaticHazardPolicy};
 pub use reference::{
     assess_obstacle, AssessContext, GuidanceOutput, ObstacleAssessment, ReferenceSystem, Sighting,
