@@ -146,6 +146,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(v) = env("ACCEPT") {
         config.tuning.guidance.acceptance_radius = v;
     }
+    if let Some(v) = env("PARALLEL") {
+        config.tuning.admm.parallel_tugs = v != 0.0;
+    }
     if let Some(v) = env("RHO") {
         config.tuning.admm.rho = v;
     }

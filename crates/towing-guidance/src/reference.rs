@@ -618,7 +618,8 @@ struct Encounters {
     standing_on: u64,
     /// The situation held for the encounter.
     held: [Option<Situation>; MAX_OBSTACLES],
-    /// The situation at the last sample (held or present).
+    /// The situation given out at the last sample: the held one, [`Situation::Safe`] for a
+    /// target ship not in an encounter or not yet with a held situation.
     situations: [Option<Situation>; MAX_OBSTACLES],
     /// Where the ship and the target ship were at the last sample (every target ship,
     /// in an encounter or not).
@@ -707,8 +708,10 @@ impl ReferenceSystem {
     }
 
     /// The COLREGS situation of obstacle slot `slot` at the last
-    /// [`update`](Self::update) (the held one of an encounter, else the present
-    /// one, as [`ObstacleAssessment::situation`]); `None` for static hazards, empty
+    /// [`update`](Self::update): the one held for its encounter (fixed when the tow
+    /// detects it, or acts for it under Rule 17, module docs), [`Situation::Safe`] for a
+    /// target ship before that or after its encounter (the present reading of the
+    /// geometry is [`ObstacleAssessment::situation`]); `None` for static hazards, empty
     /// slots and slots beyond those given.
     #[must_use]
     pub fn situation(&self, slot: usize) -> Option<Situation> {
@@ -794,7 +797,6 @@ impl ReferenceSystem {
     ) -> bool {
         let s = self.params.settings();
         let bit = 1u64 << a.index;
-        next.situations[a.index] = a.situation;
         let detection = match a.kind {
             ObstacleKind::StaticCircle => s.static_detection_distance,
             _ => s.detection_distance,
@@ -860,6 +862,13 @@ impl ReferenceSystem {
                 next.crossed |= bit;
             }
         }
+        // The situation given out (and binding the heading floor) is the one held for the
+        // encounter: until the encounter begins the tow has no role towards the target (the
+        // paper: stand-on beyond d_D), and a reading taken then is not one (a target on the
+        // starboard bow before the route's own turn to starboard is on the port bow after it).
+        next.situations[a.index] = a
+            .situation
+            .map(|_| next.held[a.index].unwrap_or(Situation::Safe));
         // An encounter found past and clear stays over until it ends (or a new
         // close-quarters situation arises, in `assess_obstacle`): the tow's own
         // return to the route must not turn an opening range into a new encounter.
@@ -1135,6 +1144,33 @@ mod tests {
         let out = rs.update(&tow, &at(7.3)).unwrap();
         assert!(!out.altered);
         assert_eq!(out.governing.unwrap().situation, Some(Situation::HeadOn));
+    }
+
+    #[test]
+    fn the_situation_given_out_is_the_one_held_from_detection() {
+        // A crossing target beyond d_D is read crossing give-way from the geometry, but the
+        // tow has no role towards it yet: safe is given out. Inside d_D the situation is
+        // held, and it stays although the reading changes (the tow turns).
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let tow = tow_at(Pose::new(2.0, 0.0, 0.0), 0.1);
+        // On the starboard bow (y east), heading west across the route.
+        let far = vessel(tow.tug2.x + 6.0, 5.0, -PI / 2.0, 0.1);
+        let g = rs.update(&tow, &[far]).unwrap().governing.unwrap();
+        assert!(!g.detected);
+        assert_eq!(g.situation, Some(Situation::CrossingGiveWay));
+        assert_eq!(rs.situation(0), Some(Situation::Safe));
+        let near = vessel(tow.tug2.x + 4.0, 3.0, -PI / 2.0, 0.1);
+        let g = rs.update(&tow, &[near]).unwrap().governing.unwrap();
+        assert!(g.detected);
+        assert_eq!(rs.situation(0), Some(Situation::CrossingGiveWay));
+        // The tow turned 140 deg to starboard: the target, now abaft her beam, is read
+        // afresh as overtaking her; the held situation is still the one given out.
+        let turned = tow_at(Pose::new(2.0, 0.0, deg(140.0)), 0.1);
+        let mut fresh = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        fresh.update(&turned, &[near]).unwrap();
+        assert_eq!(fresh.situation(0), Some(Situation::BeingOvertaken));
+        rs.update(&turned, &[near]).unwrap();
+        assert_eq!(rs.situation(0), Some(Situation::CrossingGiveWay));
     }
 
     #[test]
