@@ -476,7 +476,7 @@ fn colregs() -> Vec<Diagnostic> {
             format!("colregs[{k}].situation"),
             colregs_situation(vr_slot),
             (-1, 6),
-            format!("COLREGS situation with obstacle slot {k}: -1 none (empty slot or static hazard), 0 safe, 1 head-on, 2 crossing give-way, 3 crossing stand-on, 4 overtaking, 5 being overtaken, 6 unclassified (docs/colregs.md)"),
+            format!("COLREGS situation held for the encounter with obstacle slot {k} (0 safe before the tow detects the target or acts for it): -1 none (empty slot or static hazard), 0 safe, 1 head-on, 2 crossing give-way, 3 crossing stand-on, 4 overtaking, 5 being overtaken, 6 unclassified (docs/colregs.md)"),
             move |o| o.situation[slot],
         ));
         v.push(Diagnostic::integer(
