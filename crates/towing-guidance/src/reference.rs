@@ -618,9 +618,9 @@ struct Encounters {
     standing_on: u64,
     /// The situation held for the encounter.
     held: [Option<Situation>; MAX_OBSTACLES],
-    /// The situation given out at the last sample: the held one, [`Situation::Safe`] for a
-    /// target ship not in an encounter or not yet with a held situation.
-    situations: [Option<Situation>; MAX_OBSTACLES],
+    /// A target ship at the last sample (its situation given out is the held one, else
+    /// [`Situation::Safe`]; [`ReferenceSystem::situation`]).
+    vessels: u64,
     /// Where the ship and the target ship were at the last sample (every target ship,
     /// in an encounter or not).
     sightings: [Option<Sighting>; MAX_OBSTACLES],
@@ -643,7 +643,7 @@ impl Encounters {
             past: 0,
             standing_on: 0,
             held: [None; MAX_OBSTACLES],
-            situations: [None; MAX_OBSTACLES],
+            vessels: 0,
             sightings: [None; MAX_OBSTACLES],
         }
     }
@@ -715,7 +715,9 @@ impl ReferenceSystem {
     /// slots and slots beyond those given.
     #[must_use]
     pub fn situation(&self, slot: usize) -> Option<Situation> {
-        self.encounters.situations.get(slot).copied().flatten()
+        let e = &self.encounters;
+        (slot < MAX_OBSTACLES && e.vessels & (1 << slot) != 0)
+            .then(|| e.held[slot].unwrap_or(Situation::Safe))
     }
 
     /// True when the target ship in slot `slot` was past and clear at the last
@@ -862,13 +864,14 @@ impl ReferenceSystem {
                 next.crossed |= bit;
             }
         }
-        // The situation given out (and binding the heading floor) is the one held for the
-        // encounter: until the encounter begins the tow has no role towards the target (the
-        // paper: stand-on beyond d_D), and a reading taken then is not one (a target on the
-        // starboard bow before the route's own turn to starboard is on the port bow after it).
-        next.situations[a.index] = a
-            .situation
-            .map(|_| next.held[a.index].unwrap_or(Situation::Safe));
+        // The situation given out (and binding the heading floor) is the held one:
+        // until the encounter begins the tow has no role towards the target (the paper:
+        // stand-on beyond d_D), and a reading taken then is not one (a target on the
+        // starboard bow before the route's own turn to starboard is on the port bow after
+        // it); `ReferenceSystem::situation` gives safe for a vessel without one.
+        if a.encounter.is_some() {
+            next.vessels |= bit;
+        }
         // An encounter found past and clear stays over until it ends (or a new
         // close-quarters situation arises, in `assess_obstacle`): the tow's own
         // return to the route must not turn an opening range into a new encounter.
