@@ -121,6 +121,61 @@ impl EncounterSample {
     fn off_course(&self) -> f64 {
         self.own[2] - self.route_course
     }
+
+    /// Bearing of the target from own bow, rad (+ starboard).
+    fn bearing(&self) -> f64 {
+        relative_bearing(
+            [self.own[0], self.own[1]],
+            self.own[2],
+            [self.target[0], self.target[1]],
+        )
+    }
+}
+
+/// The largest heading change to port (deg, >= 0) while the target bore on each side of
+/// the rule checks: on the starboard side (`beta > 0`), on the port side (`beta < 0`),
+/// forward of the beam (`|beta| < 90 deg`). A port turn breaks a rule only "for" a target
+/// on the side the rule names, at the time of the turn (Rule 17(c): "not alter course to
+/// port for a vessel on her own port side"; Rule 15's give-way vessel turning to port for
+/// a target on her starboard side heads across its bow; Rule 14's port-to-port pass is
+/// spoiled by a port turn while the target is still forward of the beam). Once a crossing
+/// target has crossed ahead to the other side, a turn to port passes astern of it. The
+/// bearing is taken from the course the tow was on at detection (the heading at
+/// detection, turned with the route), not from the turned head: a turn to port brings a
+/// target on the port bow onto the starboard bow of the turned head by itself.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct PortTurns {
+    starboard_side: f64,
+    port_side: f64,
+    forward: f64,
+}
+
+impl PortTurns {
+    /// Records the heading change `dev` (deg, + starboard) of sample `s` from the course
+    /// at detection.
+    fn record(&mut self, s: &EncounterSample, dev: f64) {
+        // The target's bearing from the course at detection: from the head, turned back.
+        let beta = wrap(s.bearing() + dev.to_radians());
+        let port = (-dev).max(0.0);
+        if beta > 0.0 {
+            self.starboard_side = self.starboard_side.max(port);
+        } else if beta < 0.0 {
+            self.port_side = self.port_side.max(port);
+        }
+        if beta.abs() < std::f64::consts::FRAC_PI_2 {
+            self.forward = self.forward.max(port);
+        }
+    }
+
+    /// The one the `situation`'s rule checks (0 for the others: no port-turn check).
+    fn for_rule(&self, situation: Option<Situation>) -> f64 {
+        match situation {
+            Some(Situation::HeadOn) => self.forward,
+            Some(Situation::CrossingGiveWay) => self.starboard_side,
+            Some(Situation::CrossingStandOn) => self.port_side,
+            _ => 0.0,
+        }
+    }
 }
 
 /// The COLREGS situation: the guidance's (codes as the controller FMU's
@@ -220,6 +275,11 @@ pub struct EncounterReport {
     pub course_change_starboard_deg: Option<f64>,
     /// Largest heading change to port, deg.
     pub course_change_port_deg: Option<f64>,
+    /// Largest heading change to port made while the target bore on the side the
+    /// situation's rule names (crossing give-way: starboard; crossing stand-on: port, Rule
+    /// 17(c); head-on: forward of the beam), deg; the verdict's port-turn check uses it
+    /// (0 for the other situations).
+    pub port_turn_for_rule_deg: Option<f64>,
     /// Time of the CPA (smallest range), s.
     pub t_cpa_s: f64,
     /// Range at the CPA, m.
@@ -360,6 +420,8 @@ struct Window {
     stbd: f64,
     /// Largest heading change to port so far, deg.
     port: f64,
+    /// The same by the side the target bore on.
+    port_turns: PortTurns,
     was_altered: bool,
     /// The first action: its time, what it was, and the range then.
     action: Option<(f64, &'static str, f64)>,
@@ -430,6 +492,7 @@ impl EncounterTracker {
                 base_off_course: s.off_course(),
                 stbd: 0.0,
                 port: 0.0,
+                port_turns: PortTurns::default(),
                 was_altered: s.altered.unwrap_or(false),
                 action: None,
             });
@@ -438,6 +501,7 @@ impl EncounterTracker {
             let dev = wrap(s.off_course() - w.base_off_course).to_degrees();
             w.stbd = w.stbd.max(dev);
             w.port = w.port.max(-dev);
+            w.port_turns.record(&s, dev);
             let altered = s.altered.unwrap_or(false);
             if w.action.is_none() {
                 if altered && !w.was_altered {
@@ -510,13 +574,14 @@ impl EncounterTracker {
             base_off_course: det.off_course(),
             stbd: 0.0,
             port: 0.0,
+            port_turns: PortTurns::default(),
             was_altered: false,
             action: None,
         });
         conclude(
             &mut report,
             assessed,
-            (window.stbd, window.port),
+            (window.stbd, window.port, window.port_turns),
             window.action,
             (det.own[3], cpa.own[3]),
             p,
@@ -593,6 +658,7 @@ impl EncounterReport {
             course_change_deg: None,
             course_change_starboard_deg: None,
             course_change_port_deg: None,
+            port_turn_for_rule_deg: None,
             t_cpa_s: cpa.t,
             r_cpa_m: r_cpa,
             r_cpa_ship_lengths: r_cpa / p.ship_length_m,
@@ -625,19 +691,21 @@ struct Manoeuvre {
     /// Largest heading change to starboard and to port between detection and CPA, deg.
     stbd: f64,
     port: f64,
+    /// [`EncounterReport::port_turn_for_rule_deg`].
+    port_for_rule: f64,
     /// Relative speed change from detection to CPA.
     speed_change: f64,
     /// Whether any action was taken between detection and CPA.
     acted: bool,
 }
 
-/// Records the heading changes `(starboard, port)` (deg) since detection and the first
-/// action `(t, what, range)` in `report`, and judges it ([`judge`]) with the relative speed
+/// Records the heading changes `(starboard, port, port by side)` (deg) since detection and
+/// the first action `(t, what, range)` in `report`, and judges it ([`judge`]) with the relative speed
 /// change between `speeds` = (own speed at detection, at the CPA). `r_cpa_m` must be set.
 fn conclude(
     report: &mut EncounterReport,
     assessed: Option<Situation>,
-    (stbd, port): (f64, f64),
+    (stbd, port, port_turns): (f64, f64, PortTurns),
     action: Option<(f64, &str, f64)>,
     (speed_detect, speed_cpa): (f64, f64),
     p: &ScoringParams,
@@ -645,6 +713,8 @@ fn conclude(
     report.course_change_starboard_deg = Some(stbd);
     report.course_change_port_deg = Some(port);
     report.course_change_deg = Some(if stbd >= port { stbd } else { -port });
+    let port_for_rule = port_turns.for_rule(assessed);
+    report.port_turn_for_rule_deg = Some(port_for_rule);
     if let Some((t, what, r)) = action {
         report.t_first_action_s = Some(t);
         report.first_action = Some(what.to_owned());
@@ -654,6 +724,7 @@ fn conclude(
         r_manoeuvre: action.map_or(report.r_cpa_m, |(_, _, r)| r),
         stbd,
         port,
+        port_for_rule,
         speed_change: (speed_cpa - speed_detect) / speed_detect.abs().max(1e-3),
         acted: action.is_some(),
     };
@@ -673,6 +744,7 @@ fn judge(
         r_manoeuvre,
         stbd,
         port,
+        port_for_rule,
         speed_change,
         acted,
     } = m;
@@ -696,7 +768,10 @@ fn judge(
             p.r_col_m
         ));
     }
-    let port_turn = port >= p.port_turn_deg && port > stbd;
+    // A port turn counts only while the target bore on the side the rule names
+    // ([`PortTurns`]), and only when it was the larger turn (a starboard alteration taken
+    // back is no port turn).
+    let port_turn = port_for_rule >= p.port_turn_deg && port_for_rule > stbd;
     // Rule 16: a give-way vessel takes early and substantial action; none at all
     // between detection and the CPA is a violation (a small one only lowers the
     // score, P_na).
@@ -713,7 +788,7 @@ fn judge(
                 reasons.push("passed starboard to starboard (Rule 14: port to port)".to_owned());
             }
             if port_turn {
-                reasons.push(format!("turned {port:.0} deg to port (Rule 14)"));
+                reasons.push(format!("turned {port_for_rule:.0} deg to port (Rule 14)"));
             }
             (Some(14), Some(sc.rule14))
         }
@@ -723,7 +798,7 @@ fn judge(
             }
             if port_turn {
                 reasons.push(format!(
-                    "turned {port:.0} deg to port for a target on the starboard side (Rule 15)"
+                    "turned {port_for_rule:.0} deg to port for a target on the starboard side (Rule 15)"
                 ));
             }
             (Some(15), Some(sc.rule15))
@@ -731,7 +806,7 @@ fn judge(
         Some(Situation::CrossingStandOn) => {
             if port_turn {
                 reasons.push(format!(
-                    "turned {port:.0} deg to port for a vessel on own port side (Rule 17(c))"
+                    "turned {port_for_rule:.0} deg to port for a vessel on own port side (Rule 17(c))"
                 ));
             }
             (Some(17), Some(sc.rule17))
@@ -824,6 +899,7 @@ mod tests {
         // Heading change relative to the heading when the tow detected the target, up to the
         // CPA.
         let (mut stbd, mut port) = (0.0f64, 0.0f64);
+        let mut port_turns = PortTurns::default();
         let mut action: Option<(usize, &str)> = None;
         let altered_at_detection = det.altered.unwrap_or(false);
         let mut was_altered = altered_at_detection;
@@ -831,6 +907,7 @@ mod tests {
             let dev = wrap(s.off_course() - det.off_course()).to_degrees();
             stbd = stbd.max(dev);
             port = port.max(-dev);
+            port_turns.record(s, dev);
             let altered = s.altered.unwrap_or(false);
             if action.is_none() {
                 if altered && !was_altered {
@@ -851,7 +928,7 @@ mod tests {
         conclude(
             &mut report,
             assessed,
-            (stbd, port),
+            (stbd, port, port_turns),
             action.map(|(i, what)| (samples[i].t, what, range(&samples[i]))),
             (det.own[3], cpa.own[3]),
             p,
@@ -1014,6 +1091,43 @@ mod tests {
         assert!(a.score.expect("score") > h.score.expect("score"));
         // Geometry at detection agrees with the controller.
         assert_eq!(a.situation_geometric.as_deref(), Some("crossing give-way"));
+    }
+
+    #[test]
+    fn a_port_turn_counts_only_while_the_target_bears_on_the_rules_side() {
+        let p = params();
+        let view = ControllerView {
+            situation_codes: vec![2],
+            roles: vec!["give-way".into()],
+        };
+        // Target from 18 deg on the starboard bow crosses West 4 m ahead of own ship (at
+        // 20 s). Own ship turns 25 deg to port at 25 s, the target then on her port bow:
+        // she passes astern of it, the range still closing to the CPA at about 50 s.
+        let after = run(-25f64.to_radians(), 25.0, 6.0, 2.0, -PI / 2.0, 0.1, 0.1);
+        let a = assess("A", 4, &after, Some(&view), &p).expect("report");
+        assert_eq!(a.situation_geometric.as_deref(), Some("crossing give-way"));
+        assert!(
+            a.t_cpa_s > 25.0,
+            "the turn is inside the window: {}",
+            a.t_cpa_s
+        );
+        assert!((a.course_change_port_deg.expect("port") - 25.0).abs() < 1e-9);
+        assert_eq!(a.port_turn_for_rule_deg, Some(0.0));
+        assert_eq!(a.passed, "astern", "alpha {}", a.alpha_cpa_deg);
+        assert_eq!(a.verdict, "compliant", "{:?}", a.reasons);
+        // The same turn at 10 s, the target still on the starboard bow: a port turn for a
+        // target on the starboard side.
+        let before = run(-25f64.to_radians(), 10.0, 6.0, 2.0, -PI / 2.0, 0.1, 0.1);
+        let b = assess("A", 4, &before, Some(&view), &p).expect("report");
+        assert!((b.port_turn_for_rule_deg.expect("port") - 25.0).abs() < 1e-9);
+        assert_eq!(b.verdict, "violation");
+        assert!(
+            b.reasons
+                .iter()
+                .any(|r| r.contains("25 deg to port for a target on the starboard side")),
+            "{:?}",
+            b.reasons
+        );
     }
 
     #[test]
