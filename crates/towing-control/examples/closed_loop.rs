@@ -149,6 +149,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(v) = env("PARALLEL") {
         config.tuning.admm.parallel_tugs = v != 0.0;
     }
+    if let Some(v) = env("MOTION_PENALTY") {
+        config.tuning.ship.motion.penalty = v;
+    }
+    if let Some(v) = env("MAX_DRIFT") {
+        config.tuning.ship.motion.max_drift = v.to_radians();
+    }
     if let Some(v) = env("RHO") {
         config.tuning.admm.rho = v;
     }
@@ -305,10 +311,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     };
                     let (f2, l2) = rel(&m.tugs[1]);
                     let (f1, l1) = rel(&m.tugs[0]);
-                    eprintln!("t {t:6.1} psi {:6.1} r {:6.3} | F {:.2} {:.2} a {:6.1} {:6.1} | tug2 rel ({f2:5.2},{l2:5.2}) psi {:6.1} nu ({:.3},{:.3},{:.3}) tau {:?} | tug1 rel ({f1:5.2},{l1:5.2}) tau {:?} | it {} rp {:.1e} rd {:.1e} | pred ship ({:.2},{:.2},{:.1})",
-                        m.ship[2].to_degrees(), m.ship[5], r.command.tension[0], r.command.tension[1], r.desired_angle[0].to_degrees(), r.desired_angle[1].to_degrees(),
+                    eprintln!("t {t:6.1} psi {:6.1} r {:6.3} drift {:6.1} sog {:.3} | T {:.2} {:.2} at {:5.1} {:5.1} | F {:.2} {:.2} a {:6.1} {:6.1} | tug2 rel ({f2:5.2},{l2:5.2}) psi {:6.1} nu ({:.3},{:.3},{:.3}) tau {:?} | tug1 rel ({f1:5.2},{l1:5.2}) tau {:?} | it {} rp {:.1e} rd {:.1e} | pred ship ({:.2},{:.2},{:.1}) pdrift {:.1} {:.1} {:.1}",
+                        m.ship[2].to_degrees(), m.ship[5], m.ship[4].atan2(m.ship[3]).to_degrees(), m.ship[3].hypot(m.ship[4]), world.towline(0).tension, world.towline(1).tension, world.towline(0).angle.to_degrees(), world.towline(1).angle.to_degrees(), r.command.tension[0], r.command.tension[1], r.desired_angle[0].to_degrees(), r.desired_angle[1].to_degrees(),
                         m.tugs[1][2].to_degrees(), m.tugs[1][3], m.tugs[1][4], m.tugs[1][5], r.command.tug_thrust[1].map(|v| (v * 100.0).round() / 100.0), r.command.tug_thrust[0].map(|v| (v * 100.0).round() / 100.0),
-                        r.iterations, r.r_pri[1], r.r_dual[1], r.prediction.ship[2][0], r.prediction.ship[2][1], r.prediction.ship[2][2].to_degrees());
+                        r.iterations, r.r_pri[1], r.r_dual[1], r.prediction.ship[2][0], r.prediction.ship[2][1], r.prediction.ship[2][2].to_degrees(), r.prediction.ship[0][4].atan2(r.prediction.ship[0][3]).to_degrees(), r.prediction.ship[1][4].atan2(r.prediction.ship[1][3]).to_degrees(), r.prediction.ship[2][4].atan2(r.prediction.ship[2][3]).to_degrees());
                 }
             }
             if std::env::var("DEBUG").is_ok() && n % (per_sample * 5) == 0 {
