@@ -130,6 +130,15 @@ impl EncounterSample {
             [self.target[0], self.target[1]],
         )
     }
+
+    /// Contact angle: bearing of own ship from the target's bow, rad (+ starboard).
+    fn contact_angle(&self) -> f64 {
+        relative_bearing(
+            [self.target[0], self.target[1]],
+            self.target[2],
+            [self.own[0], self.own[1]],
+        )
+    }
 }
 
 /// The largest heading change to port (deg, >= 0) while the target bore on each side of
@@ -427,6 +436,20 @@ struct Window {
     action: Option<(f64, &'static str, f64)>,
 }
 
+impl Window {
+    /// The window opened at the tow's detection `s`: no heading change, no action yet.
+    fn at_detection(s: &EncounterSample) -> Window {
+        Window {
+            base_off_course: s.off_course(),
+            stbd: 0.0,
+            port: 0.0,
+            port_turns: PortTurns::default(),
+            was_altered: s.altered.unwrap_or(false),
+            action: None,
+        }
+    }
+}
+
 /// The closest point of approach so far, with the window as it was then.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Cpa {
@@ -488,14 +511,7 @@ impl EncounterTracker {
         // vessel (tow_range) within r_detect.
         if self.window.is_none() && (range < self.p.r_detect_m || s.tow_range < self.p.r_detect_m) {
             self.detect_tow = Some(s);
-            self.window = Some(Window {
-                base_off_course: s.off_course(),
-                stbd: 0.0,
-                port: 0.0,
-                port_turns: PortTurns::default(),
-                was_altered: s.altered.unwrap_or(false),
-                action: None,
-            });
+            self.window = Some(Window::at_detection(&s));
         }
         if let Some(w) = &mut self.window {
             let dev = wrap(s.off_course() - w.base_off_course).to_degrees();
@@ -570,14 +586,7 @@ impl EncounterTracker {
         // too, and the window holds the heading changes from there up to the CPA.
         let det = self.detect_tow.unwrap_or(det_ship);
         report.t_detect_tow_s = Some(det.t);
-        let window = cpa_rec.window.unwrap_or(Window {
-            base_off_course: det.off_course(),
-            stbd: 0.0,
-            port: 0.0,
-            port_turns: PortTurns::default(),
-            was_altered: false,
-            action: None,
-        });
+        let window = cpa_rec.window.unwrap_or(Window::at_detection(&det));
         conclude(
             &mut report,
             assessed,
@@ -607,10 +616,8 @@ impl EncounterReport {
         at_end: bool,
         p: &ScoringParams,
     ) -> (Self, Option<Situation>) {
-        let own_p = [cpa.own[0], cpa.own[1]];
-        let tgt_p = [cpa.target[0], cpa.target[1]];
-        let beta_cpa = relative_bearing(own_p, cpa.own[2], tgt_p).to_degrees();
-        let alpha_cpa = relative_bearing(tgt_p, cpa.target[2], own_p).to_degrees();
+        let beta_cpa = cpa.bearing().to_degrees();
+        let alpha_cpa = cpa.contact_angle().to_degrees();
 
         // Controller's situation: the first definite one (neither safe nor unclassified:
         // the one the guidance holds for the encounter, towing-guidance's reference
@@ -632,13 +639,12 @@ impl EncounterReport {
         }
 
         let geometric = det_ship.map(|s| {
-            let beta = relative_bearing([s.own[0], s.own[1]], s.own[2], [s.target[0], s.target[1]]);
-            let alpha = relative_bearing(
-                [s.target[0], s.target[1]],
-                s.target[2],
-                [s.own[0], s.own[1]],
-            );
-            classify(beta.to_degrees(), alpha.to_degrees(), s.own[3], s.target[3])
+            classify(
+                s.bearing().to_degrees(),
+                s.contact_angle().to_degrees(),
+                s.own[3],
+                s.target[3],
+            )
         });
         let assessed = situation.or(geometric);
 
@@ -936,6 +942,14 @@ mod tests {
         Some(report)
     }
 
+    /// The controller's view of a target it gave way to in `situation` throughout.
+    fn give_way_view(situation: Situation) -> ControllerView {
+        ControllerView {
+            situation_codes: vec![situation.code()],
+            roles: vec!["give-way".into()],
+        }
+    }
+
     fn params() -> ScoringParams {
         ScoringParams::model_scale(1.255, 1.48, (7.0, 0.25), 0.05)
     }
@@ -1049,10 +1063,7 @@ mod tests {
         // The turn at 128 s comes after the forward tug (2 m ahead) is within 7 m of the
         // target (about 123.5 s) but before the ship is (135.3 s).
         let mut samples = run(30f64.to_radians(), 128.0, 30.0, -0.5, PI, 0.07, 0.1);
-        let view = ControllerView {
-            situation_codes: vec![1],
-            roles: vec!["give-way".into()],
-        };
+        let view = give_way_view(Situation::HeadOn);
         let ship_only = assess("C", 6, &samples, Some(&view), &p).expect("report");
         assert!(ship_only.t_first_action_s.is_none());
         assert_eq!(ship_only.verdict, "violation");
@@ -1074,10 +1085,7 @@ mod tests {
         // Target crosses from starboard to port (course West) ahead of own ship.
         // Passing astern: turn to starboard (towards where the target comes from, behind
         // it). Passing ahead: keep course and be faster than the target's crossing.
-        let view = ControllerView {
-            situation_codes: vec![2],
-            roles: vec!["give-way".into()],
-        };
+        let view = give_way_view(Situation::CrossingGiveWay);
         let astern = run(60f64.to_radians(), 20.0, 6.0, 4.0, -PI / 2.0, 0.07, 0.1);
         let ahead = run(0.0, 20.0, 5.0, 3.0, -PI / 2.0, 0.07, 0.25);
         let a = assess("A", 4, &astern, Some(&view), &p).expect("report");
@@ -1096,10 +1104,7 @@ mod tests {
     #[test]
     fn a_port_turn_counts_only_while_the_target_bears_on_the_rules_side() {
         let p = params();
-        let view = ControllerView {
-            situation_codes: vec![2],
-            roles: vec!["give-way".into()],
-        };
+        let view = give_way_view(Situation::CrossingGiveWay);
         // Target from 18 deg on the starboard bow crosses West 4 m ahead of own ship (at
         // 20 s). Own ship turns 25 deg to port at 25 s, the target then on her port bow:
         // she passes astern of it, the range still closing to the CPA at about 50 s.
