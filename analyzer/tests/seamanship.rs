@@ -832,3 +832,84 @@ fn seamanship_rule_17_allows_action_by_the_cpa_before_detection() {
     assert!(target.t_stand_on_broken_s.is_none(), "{target:?}");
     assert!(!metrics(&verdict(&r)).contains(&"rule17_stand_on"));
 }
+
+#[test]
+fn seamanship_a_stand_on_departure_made_while_acting_for_another_target_is_excused() {
+    // Two targets (random-12-0296 is of this kind): one from starboard the tow gives way
+    // to (on the route line at x = 30 m at 461.5 s), one from port she stands on for
+    // (eastward at 0.02 m/s along x = 27 m, TCPA over 60 s until about 590 s). She slows
+    // to 40 % of cruise at 360 s for the first (her give-way action, detected at about
+    // 358 s, past and clear at about 462 s) and resumes at 480 s: a lawful action for
+    // the first is no breach of the stand-on duty to the second (Rule 2(b)).
+    let give_way = Target {
+        name: "starboard",
+        at_t0: [30.0, 0.05 * 30.0 / CRUISE],
+        course_deg: 270.0,
+        speed: 0.05,
+    };
+    let stand_on = || Target {
+        name: "port",
+        at_t0: [27.0, -0.02 * 660.0],
+        course_deg: 90.0,
+        speed: 0.02,
+    };
+    // Slow at 360 s to 40 % of cruise, to `later` of it from 470 s, cruise from 480 s.
+    let slow = |later: f64| {
+        move |t: f64, p: [f64; 2]| {
+            if t > 360.0 && t <= 470.0 {
+                (0.0, 0.4 * CRUISE, 0.0)
+            } else if t > 470.0 && t <= 480.0 {
+                (0.0, later * CRUISE, 0.0)
+            } else {
+                cruise(t, p)
+            }
+        }
+    };
+    let broken = |r: &SeamanshipReport| {
+        let port = r
+            .rules
+            .targets
+            .iter()
+            .find(|t| t.target == "port")
+            .expect("port");
+        assert_eq!(
+            port.situation.as_deref(),
+            Some("crossing stand-on"),
+            "{port:?}"
+        );
+        assert!(port.t_detect_s.is_some_and(|t| t < 360.0), "{port:?}");
+        assert!(port.t_rule17_s.is_none_or(|t| t > 480.0), "{port:?}");
+        port.t_stand_on_broken_s
+    };
+    // Alone, the port target's stand-on is broken by the slowing.
+    let r = run(700.0, slow(0.4), no_offset, &[stand_on()]);
+    let t = broken(&r).expect("broken");
+    assert!((360.0..=361.0).contains(&t), "{t}");
+    assert!(metrics(&verdict(&r)).contains(&"rule17_stand_on"));
+    // With the give-way target, the same slowing is its action: excused.
+    let r = run(700.0, slow(0.4), no_offset, &[give_way, stand_on()]);
+    let starboard = &r.rules.targets[0];
+    assert_eq!(starboard.situation.as_deref(), Some("crossing give-way"));
+    assert_eq!(starboard.action.as_deref(), Some("way off"));
+    let clear = starboard.t_past_and_clear_s.expect("past and clear");
+    assert!((455.0..470.0).contains(&clear), "{starboard:?}");
+    assert_eq!(broken(&r), None);
+    let port = &r.rules.targets[1];
+    assert_eq!(port.stand_on_excused_by.as_deref(), Some("starboard"));
+    assert!(
+        !metrics(&verdict(&r)).contains(&"rule17_stand_on"),
+        "{:?}",
+        verdict(&r)
+    );
+    // Slowing further once the give-way target is past is a departure of her own.
+    let give_way = Target {
+        name: "starboard",
+        at_t0: [30.0, 0.05 * 30.0 / CRUISE],
+        course_deg: 270.0,
+        speed: 0.05,
+    };
+    let r = run(700.0, slow(0.2), no_offset, &[give_way, stand_on()]);
+    let t = broken(&r).expect("broken");
+    assert!((470.0..=471.0).contains(&t), "{t}");
+    assert!(metrics(&verdict(&r)).contains(&"rule17_stand_on"));
+}

@@ -29,7 +29,12 @@
 //! - stand-on (Rule 17; crossing stand-on, being overtaken): until Rule 17(a)(ii) allows
 //!   action (TCPA <= `rule17_tcpa_s`, from the first step the target is present: before
 //!   detection with a DCPA within `d_detect` too), heading within `stand_on_course_deg` and speed over
-//!   ground at least `stand_on_speed_fraction` of their values at detection; Rule 17(c):
+//!   ground at least `stand_on_speed_fraction` of their values at detection, except while
+//!   the tow owes another target an action (gives way to it, or Rule 17 lets her act for
+//!   it, until it is past and clear): the rules bind pairwise and a lawful action for one
+//!   vessel is no breach of the stand-on duty to another (Rule 2(b)); what that action
+//!   left (the largest course change, the least speed) widens the limits afterwards, so
+//!   she may come back from it but not depart further; Rule 17(c):
 //!   never a port turn of more than `port_turn_max_deg` while the target is on the port
 //!   side, until it is past and clear;
 //! - overtaking (Rule 13): hull clearance of every vessel of the tow from the target at
@@ -157,6 +162,13 @@ pub struct TargetRules {
     pub stand_on_speed_fraction: Option<f64>,
     /// First time the stand-on course or speed bound was broken before then, s.
     pub t_stand_on_broken_s: Option<f64>,
+    /// The first other target the tow owed an action to while she stood on for this one
+    /// (give-way from its detection, or Rule 17 action allowed, until it was past and
+    /// clear): her course and speed were not judged for this target while she did, and
+    /// afterwards only a departure beyond what that action left counts (Rule 2(b)).
+    pub stand_on_excused_by: Option<String>,
+    /// When that began, s.
+    pub t_stand_on_excused_s: Option<f64>,
     /// Largest port turn (from the heading at detection) while the target was on the port
     /// side, before it was past and clear, deg.
     pub port_turn_port_target_deg: Option<f64>,
@@ -202,6 +214,12 @@ struct Target {
     crossed_before: Option<f64>,
     /// Each vessel's last side (non-zero) of the target's course line.
     prev_cross: [Option<f64>; 3],
+    /// The other target the tow owes an action to at this step ([`Target::owes_action`]),
+    /// by name; set by [`RulesTracker::push`] before the checks.
+    excused_by: Option<String>,
+    /// The stand-on bounds left by the tow's actions for other targets: the largest
+    /// course change (deg) and the least speed fraction reached while excused.
+    relief: Option<(f64, f64)>,
 }
 
 /// Own vessels with the sizes, as the checks need them.
@@ -248,6 +266,8 @@ impl Target {
                 stand_on_course_change_deg: None,
                 stand_on_speed_fraction: None,
                 t_stand_on_broken_s: None,
+                stand_on_excused_by: None,
+                t_stand_on_excused_s: None,
                 port_turn_port_target_deg: None,
                 t_port_turn_s: None,
                 min_hull_clearance_m: None,
@@ -261,6 +281,8 @@ impl Target {
             prev_pose: None,
             crossed_before: None,
             prev_cross: [None; 3],
+            excused_by: None,
+            relief: None,
         }
     }
 
@@ -275,6 +297,17 @@ impl Target {
             && self.det.is_some()
             && self.r.t_past_and_clear_s.is_none()
             && self.situation().is_some_and(is_give_way)
+    }
+
+    /// Whether the tow owes this target an action: she gives way to it
+    /// ([`Target::open_give_way`]), or she stands on for it and Rule 17(a)(ii) allows her
+    /// to act, until it is past and clear.
+    fn owes_action(&self) -> bool {
+        self.open_give_way()
+            || (self.present
+                && self.r.t_rule17_s.is_some()
+                && self.r.t_past_and_clear_s.is_none()
+                && self.situation().is_some_and(is_stand_on))
     }
 
     /// The controller's first definite situation for the slot.
@@ -509,8 +542,9 @@ impl Target {
         }
     }
 
-    /// Rule 17: course and speed kept until action is allowed; no port turn for a target
-    /// on the port side until it is past and clear.
+    /// Rule 17: course and speed kept until action is allowed, except while the tow acts
+    /// for another target (Rule 2(b)); no port turn for a target on the port side until it
+    /// is past and clear.
     fn stand_on(
         &mut self,
         t: f64,
@@ -531,19 +565,7 @@ impl Target {
                 } else {
                     1.0
                 };
-                let course = self
-                    .r
-                    .stand_on_course_change_deg
-                    .unwrap_or(0.0)
-                    .max(turn.abs());
-                let speed = self.r.stand_on_speed_fraction.unwrap_or(1.0).min(fraction);
-                self.r.stand_on_course_change_deg = Some(course);
-                self.r.stand_on_speed_fraction = Some(speed);
-                let broken =
-                    turn.abs() > th.stand_on_course_deg || fraction < th.stand_on_speed_fraction;
-                if broken && self.r.t_stand_on_broken_s.is_none() {
-                    self.r.t_stand_on_broken_s = Some(t);
-                }
+                self.keep_course_and_speed(t, turn.abs(), fraction, th);
             }
         }
         if beta < 0.0 && self.r.t_past_and_clear_s.is_none() {
@@ -552,6 +574,34 @@ impl Target {
                 self.r.port_turn_port_target_deg = Some(port);
                 self.r.t_port_turn_s = Some(t);
             }
+        }
+    }
+
+    /// Rule 17(a)(i): the course change `turn` (deg, magnitude) and the speed `fraction` of
+    /// its value at detection, before Rule 17 allows action. While the tow owes another
+    /// target an action ([`Target::excused_by`]) they are not judged but widen the bounds
+    /// (the relief); afterwards the bounds are the thresholds or the relief, whichever is
+    /// wider: she may come back from what she did for the other vessel, not go further.
+    fn keep_course_and_speed(&mut self, t: f64, turn: f64, fraction: f64, th: &Thresholds) {
+        if let Some(by) = &self.excused_by {
+            if self.r.stand_on_excused_by.is_none() {
+                self.r.stand_on_excused_by = Some(by.clone());
+                self.r.t_stand_on_excused_s = Some(t);
+            }
+            let (c, f) = self.relief.unwrap_or((0.0, 1.0));
+            self.relief = Some((c.max(turn), f.min(fraction)));
+            return;
+        }
+        let (relief_course, relief_speed) = self.relief.unwrap_or((0.0, 1.0));
+        let course_max = th.stand_on_course_deg.max(relief_course);
+        let speed_min = th.stand_on_speed_fraction.min(relief_speed);
+        let course = self.r.stand_on_course_change_deg.unwrap_or(0.0).max(turn);
+        let speed = self.r.stand_on_speed_fraction.unwrap_or(1.0).min(fraction);
+        self.r.stand_on_course_change_deg = Some(course);
+        self.r.stand_on_speed_fraction = Some(speed);
+        let broken = turn > course_max || fraction < speed_min;
+        if broken && self.r.t_stand_on_broken_s.is_none() {
+            self.r.t_stand_on_broken_s = Some(t);
         }
     }
 
@@ -615,8 +665,19 @@ impl RulesTracker {
 
     /// The next step.
     pub fn push(&mut self, step: &PlantStep<'_>) {
-        for t in &mut self.targets {
+        // The actions the tow owed after the last step: each excuses the stand-on checks
+        // of the other targets at this one.
+        let owed: Vec<Option<String>> = self
+            .targets
+            .iter()
+            .map(|t| t.owes_action().then(|| t.r.target.clone()))
+            .collect();
+        for (k, t) in self.targets.iter_mut().enumerate() {
             t.present = false;
+            t.excused_by = owed
+                .iter()
+                .enumerate()
+                .find_map(|(j, name)| if j == k { None } else { name.clone() });
         }
         let ship = step.vessels[0];
         let course = self.course.at([ship.x, ship.y]);
@@ -803,13 +864,19 @@ fn give_way_reasons(r: &TargetRules, s: Situation, th: &Thresholds, out: &mut Ve
 fn stand_on_reasons(r: &TargetRules, th: &Thresholds, out: &mut Vec<Reason>) {
     let name = r.target.as_str();
     if let Some(t) = r.t_stand_on_broken_s {
+        let relieved = match (&r.stand_on_excused_by, r.t_stand_on_excused_s) {
+            (Some(by), Some(from)) => format!(
+                "; the limits widened to what her action for {by} from {from:.1} s left"
+            ),
+            _ => String::new(),
+        };
         out.push(Reason::target(
             "rule17_stand_on",
             name,
             Some(t),
             format!(
                 "course or speed not kept before Rule 17 allowed action (course change up to \
-                 {:.1} deg, limit {}; speed down to {:.0} %, limit {:.0} %)",
+                 {:.1} deg, limit {}; speed down to {:.0} %, limit {:.0} %{relieved})",
                 r.stand_on_course_change_deg.unwrap_or(0.0),
                 th.stand_on_course_deg,
                 100.0 * r.stand_on_speed_fraction.unwrap_or(1.0),
