@@ -841,7 +841,7 @@ fn seamanship_a_stand_on_departure_made_while_acting_for_another_target_is_excus
     // to 40 % of cruise at 360 s for the first (her give-way action, detected at about
     // 358 s, past and clear at about 462 s) and resumes at 480 s: a lawful action for
     // the first is no breach of the stand-on duty to the second (Rule 2(b)).
-    let give_way = Target {
+    let give_way = || Target {
         name: "starboard",
         at_t0: [30.0, 0.05 * 30.0 / CRUISE],
         course_deg: 270.0,
@@ -887,7 +887,7 @@ fn seamanship_a_stand_on_departure_made_while_acting_for_another_target_is_excus
     assert!((360.0..=361.0).contains(&t), "{t}");
     assert!(metrics(&verdict(&r)).contains(&"rule17_stand_on"));
     // With the give-way target, the same slowing is its action: excused.
-    let r = run(700.0, slow(0.4), no_offset, &[give_way, stand_on()]);
+    let r = run(700.0, slow(0.4), no_offset, &[give_way(), stand_on()]);
     let starboard = &r.rules.targets[0];
     assert_eq!(starboard.situation.as_deref(), Some("crossing give-way"));
     assert_eq!(starboard.action.as_deref(), Some("way off"));
@@ -902,13 +902,7 @@ fn seamanship_a_stand_on_departure_made_while_acting_for_another_target_is_excus
         verdict(&r)
     );
     // Slowing further once the give-way target is past is a departure of her own.
-    let give_way = Target {
-        name: "starboard",
-        at_t0: [30.0, 0.05 * 30.0 / CRUISE],
-        course_deg: 270.0,
-        speed: 0.05,
-    };
-    let r = run(700.0, slow(0.2), no_offset, &[give_way, stand_on()]);
+    let r = run(700.0, slow(0.2), no_offset, &[give_way(), stand_on()]);
     let t = broken(&r).expect("broken");
     assert!((470.0..=471.0).contains(&t), "{t}");
     assert!(metrics(&verdict(&r)).contains(&"rule17_stand_on"));
