@@ -156,9 +156,10 @@ pub struct TargetRules {
     /// When Rule 17 allowed the stand-on vessel to act (TCPA <= `rule17_tcpa_s`; before
     /// detection also with the DCPA within `d_detect`), s.
     pub t_rule17_s: Option<f64>,
-    /// Largest heading change before then, deg.
+    /// Largest heading change before then, deg (outside the steps excused, below).
     pub stand_on_course_change_deg: Option<f64>,
-    /// Least speed over ground before then, as a fraction of its value at detection.
+    /// Least speed over ground before then, as a fraction of its value at detection
+    /// (outside the steps excused, below).
     pub stand_on_speed_fraction: Option<f64>,
     /// First time the stand-on course or speed bound was broken before then, s.
     pub t_stand_on_broken_s: Option<f64>,
@@ -214,9 +215,11 @@ struct Target {
     crossed_before: Option<f64>,
     /// Each vessel's last side (non-zero) of the target's course line.
     prev_cross: [Option<f64>; 3],
-    /// The other target the tow owes an action to at this step ([`Target::owes_action`]),
-    /// by name; set by [`RulesTracker::push`] before the checks.
-    excused_by: Option<String>,
+    /// The other target (its index among the tracker's) the tow owes an action to at
+    /// this step ([`Target::owes_action`]); set by [`RulesTracker::push`] before the checks.
+    excused_by: Option<usize>,
+    /// The first of those that excused a stand-on check (its name goes to the report).
+    excused_first: Option<usize>,
     /// The stand-on bounds left by the tow's actions for other targets: the largest
     /// course change (deg) and the least speed fraction reached while excused.
     relief: Option<(f64, f64)>,
@@ -282,6 +285,7 @@ impl Target {
             crossed_before: None,
             prev_cross: [None; 3],
             excused_by: None,
+            excused_first: None,
             relief: None,
         }
     }
@@ -583,9 +587,9 @@ impl Target {
     /// (the relief); afterwards the bounds are the thresholds or the relief, whichever is
     /// wider: she may come back from what she did for the other vessel, not go further.
     fn keep_course_and_speed(&mut self, t: f64, turn: f64, fraction: f64, th: &Thresholds) {
-        if let Some(by) = &self.excused_by {
-            if self.r.stand_on_excused_by.is_none() {
-                self.r.stand_on_excused_by = Some(by.clone());
+        if let Some(by) = self.excused_by {
+            if self.excused_first.is_none() {
+                self.excused_first = Some(by);
                 self.r.t_stand_on_excused_s = Some(t);
             }
             let (c, f) = self.relief.unwrap_or((0.0, 1.0));
@@ -666,18 +670,14 @@ impl RulesTracker {
     /// The next step.
     pub fn push(&mut self, step: &PlantStep<'_>) {
         // The actions the tow owed after the last step: each excuses the stand-on checks
-        // of the other targets at this one.
-        let owed: Vec<Option<String>> = self
-            .targets
-            .iter()
-            .map(|t| t.owes_action().then(|| t.r.target.clone()))
-            .collect();
+        // of the other targets at this one (the first two owed name one for every target).
+        let mut owed = (self.targets.iter().enumerate())
+            .filter(|(_, t)| t.owes_action())
+            .map(|(j, _)| j);
+        let (first, second) = (owed.next(), owed.next());
         for (k, t) in self.targets.iter_mut().enumerate() {
             t.present = false;
-            t.excused_by = owed
-                .iter()
-                .enumerate()
-                .find_map(|(j, name)| if j == k { None } else { name.clone() });
+            t.excused_by = if first == Some(k) { second } else { first };
         }
         let ship = step.vessels[0];
         let course = self.course.at([ship.x, ship.y]);
@@ -721,6 +721,7 @@ impl RulesTracker {
     /// The report.
     #[must_use]
     pub fn finish(self) -> RulesReport {
+        let names: Vec<String> = self.targets.iter().map(|t| t.r.target.clone()).collect();
         RulesReport {
             targets: self
                 .targets
@@ -733,6 +734,7 @@ impl RulesTracker {
                     };
                     t.r.situation = s.map(|s| s.name().to_owned());
                     t.r.situation_source = source;
+                    t.r.stand_on_excused_by = t.excused_first.and_then(|j| names.get(j).cloned());
                     t.r
                 })
                 .collect(),
