@@ -232,8 +232,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(v) = env("TUG_RMAX") {
         config.tuning.tug.max_yaw_rate = v;
     }
-    if let Some(v) = env("OWN_SHIP") {
-        config.tuning.tug.own_ship_row = v > 0.0;
+    if let Some(v) = env("TOW_ROWS") {
+        config.tuning.tug.tow_rows = v > 0.0;
     }
     if let Some(v) = env("PT_W") {
         config.tuning.ship.weight_port_turn = v;

@@ -41,6 +41,7 @@ fn bench(c: &mut Criterion) {
         distance_cost_off: 0,
         waterway: None,
         own_ship: None,
+        other_tug: None,
     };
     let tug_plan = [[1.0, 0.0, 0.0]; HORIZON];
     c.bench_function("tug_scp_step", |b| {

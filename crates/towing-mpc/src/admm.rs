@@ -631,6 +631,9 @@ impl Core<'_> {
         side: &ShipSide,
     ) -> ([ScpReport; 2], [Poses; 2]) {
         let own_ship = self.formation.ship_obstacle(&input.ship, &side.states);
+        let sample_time = self.tug1.problem().model().params().sample_time;
+        let tug = |i: usize| (self.formation).tug_obstacle(i, &tug_states[i], sample_time);
+        let tugs = [tug(0), tug(1)];
         let data = |i: usize| TugStepData {
             state: tug_states[i],
             pulls: std::array::from_fn(|h| {
@@ -648,6 +651,7 @@ impl Core<'_> {
             distance_cost_off: input.distance_cost_off,
             waterway: input.waterway,
             own_ship: Some(own_ship),
+            other_tug: Some(tugs[1 - i]),
         };
         self.tug2.start(&data(1));
         let first = self.tug1.step(&data(0));

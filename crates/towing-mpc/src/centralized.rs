@@ -103,6 +103,9 @@ type Sens = SMatrix<f64, 6, NU>;
 /// all three (the tugs through the pulls), a tug's thrust its own tug only.
 const SHIP: u8 = 1;
 const TUG: [u8; 2] = [2, 4];
+/// The pairs of the tow's own vessels kept apart (0 the ship, `1 + i` tug `i`): the
+/// first vessel's reference point from the second's hull.
+const TOW_PAIRS: [(usize, usize); 3] = [(1, 0), (2, 0), (1, 2)];
 
 /// Index of ship channel `k` of sample `h`.
 fn ship_var(h: usize, k: usize) -> usize {
@@ -315,8 +318,9 @@ pub struct CentralLinearised {
 }
 
 /// The centralized problem's soft rows: the consensus rows, then the clearance
-/// rows of the ship, tug 1 and tug 2, the ship's motion limits and the bank rows of the
-/// three vessels.
+/// rows of the ship, tug 1 and tug 2, the ship's motion limits, the bank rows of the
+/// three vessels, the tugs' yaw-rate rows and the rows keeping the tow's own vessels
+/// apart ([`CentralProblem::tow_terms`]).
 #[derive(Debug, Clone)]
 pub struct CentralRows {
     consensus: PairRows,
@@ -324,6 +328,7 @@ pub struct CentralRows {
     motion: SlotRows,
     bank: [SlotRows; 3],
     yaw: [SlotRows; 2],
+    tow: SlotRows,
 }
 
 impl RowSet for CentralRows {
@@ -333,6 +338,7 @@ impl RowSet for CentralRows {
             .chain(std::iter::once(Block::Slots(&self.motion)))
             .chain(self.bank.iter().map(Block::Slots))
             .chain(self.yaw.iter().map(Block::Slots))
+            .chain(std::iter::once(Block::Slots(&self.tow)))
     }
     fn blocks_mut(&mut self) -> impl Iterator<Item = BlockMut<'_>> {
         std::iter::once(BlockMut::Pairs(&mut self.consensus))
@@ -340,6 +346,7 @@ impl RowSet for CentralRows {
             .chain(std::iter::once(BlockMut::Slots(&mut self.motion)))
             .chain(self.bank.iter_mut().map(BlockMut::Slots))
             .chain(self.yaw.iter_mut().map(BlockMut::Slots))
+            .chain(std::iter::once(BlockMut::Slots(&mut self.tow)))
     }
 }
 
@@ -474,6 +481,57 @@ impl CentralProblem {
         }
     }
 
+    /// The rows keeping the tow's own vessels apart at sample `h` ([`TOW_PAIRS`]), as the
+    /// tugs' local problems keep them (`TugStepData::own_ship`, `other_tug`): a vessel's
+    /// reference point at least `d_min` from the other's hull ellipse
+    /// ([`FormationMap::hull`] at its predicted pose). The row moves with both vessels:
+    /// with `grad` the distance's gradient at the point `p` and `c`, `psi` the hull's
+    /// centre and heading, `dd = grad . (dp - dc) + (grad_x (p - c)_y - grad_y (p - c)_x)
+    /// dpsi` (a common translation leaves the distance unchanged; turning the hull by
+    /// `dpsi` about `c` is turning the point by `-dpsi` about it).
+    fn tow_terms(
+        &self,
+        quad: &mut QuadModel,
+        traj: &Trajectory,
+        sens: Option<&Sensitivities>,
+        mut tow: Option<&mut SlotRows>,
+        h: usize,
+    ) {
+        let tp = &self.tug_params;
+        let state = |v: usize| {
+            if v == 0 {
+                &traj.ship[h]
+            } else {
+                &traj.tugs[v - 1][h]
+            }
+        };
+        let rows = |v: usize| {
+            sens.map_or([[0.0; NU]; 6], |s| {
+                sens_rows(if v == 0 {
+                    &s.ship[h]
+                } else {
+                    &s.tugs[v - 1][h]
+                })
+            })
+        };
+        for (j, (a, b)) in TOW_PAIRS.into_iter().enumerate() {
+            let (xa, xb) = (state(a), state(b));
+            let hull = self.formation.hull(b, [xb[0], xb[1], xb[2]], [0.0; 2]);
+            let (d, grad) = hull.distance([xa[0], xa[1]]);
+            quad.value += tp.clearance.penalty_at(d);
+            if let Some(t) = tow.as_deref_mut() {
+                let (ra, rb) = (rows(a), rows(b));
+                let turn = grad[0] * (xa[1] - xb[1]) - grad[1] * (xa[0] - xb[0]);
+                let row: [f64; NU] = std::array::from_fn(|k| {
+                    grad[0] * (ra[0][k] - rb[0][k])
+                        + grad[1] * (ra[1][k] - rb[1][k])
+                        + turn * rb[2][k]
+                });
+                t.record(h, j, d, tp.clearance.min_distance, &row);
+            }
+        }
+    }
+
     /// The cost terms of `traj` reached with `plan`; with `lin` the model rows
     /// too (consensus and clearance rows recorded).
     fn accumulate(
@@ -568,6 +626,12 @@ impl CentralProblem {
                 let yaw = rows_out.as_deref_mut().map(|r| &mut r.yaw[i]);
                 tug_yaw_rate_terms(quad, tp.yaw_rate_limit(), yaw, h, g[5], &rows[5]);
                 out.tugs[i] += quad.value - start;
+            }
+            if tp.tow_rows {
+                let start = quad.value;
+                let tow = rows_out.as_deref_mut().map(|r| &mut r.tow);
+                self.tow_terms(quad, traj, sens, tow, h);
+                out.tugs[0] += quad.value - start;
             }
         }
         out.merit = out.total() + self.settings.consensus_penalty * out.consensus_l1;
@@ -669,6 +733,9 @@ impl Subproblem for CentralProblem {
                 self.tug_params.yaw_rate_rows(PER_STEP, TUG[0]),
                 self.tug_params.yaw_rate_rows(PER_STEP, TUG[1]),
             ],
+            tow: (self.tug_params.clearance)
+                .slots(TOW_PAIRS.len() * usize::from(self.tug_params.tow_rows))
+                .rows(PER_STEP, SHIP | TUG[0] | TUG[1]),
         }
     }
 

@@ -90,13 +90,19 @@ impl ClearanceParams {
     }
 
     /// The same row kind with one slot when `on`, none otherwise: the bank row
-    /// ([`bank_terms`]) or a tug's row about its own ship
-    /// ([`crate::TugMpcParams::own_ship_row`]). A problem without them keeps exactly
-    /// the QP it had before they existed.
+    /// ([`bank_terms`]). A problem without them keeps exactly the QP it had before they
+    /// existed.
     #[must_use]
     pub fn single(&self, on: bool) -> ClearanceParams {
+        self.slots(usize::from(on))
+    }
+
+    /// The same row kind with `n` slots: the tug's rows about the tow's own vessels
+    /// ([`crate::TugMpcParams::tow_rows`]).
+    #[must_use]
+    pub fn slots(&self, n: usize) -> ClearanceParams {
         ClearanceParams {
-            max_obstacles: usize::from(on),
+            max_obstacles: n,
             ..*self
         }
     }

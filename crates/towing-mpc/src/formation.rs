@@ -27,23 +27,53 @@ pub struct FormationMap {
 }
 
 impl FormationMap {
-    /// The ship's hull as the tugs' local problems keep clear of it (`docs/controller-design.md`,
-    /// "Tug local MPCs"): the ellipse through the corners of the ship's `L x B` rectangle
+    /// A hull as the other vessels of the tow keep clear of it (`docs/controller-design.md`,
+    /// "Tug local MPCs"): the ellipse through the corners of its `L x B` rectangle
     /// (semi-axes `L / sqrt 2`, `B / sqrt 2`, the smallest ellipse of the hull's aspect
-    /// that contains it) at the ship's present pose `ship`, heading held, moving by the
-    /// mean displacement per sample of the coordination's predicted trajectory
-    /// `predicted` (the constant-velocity motion [`Obstacle::after`] predicts).
+    /// that contains it) at `pose` `[x, y, psi]`, moving by `drift` per sample, heading
+    /// held (the constant-velocity motion [`Obstacle::after`] predicts). `vessel`: 0 the
+    /// ship, `1 + i` tug `i`.
+    #[must_use]
+    pub fn hull(&self, vessel: usize, pose: [f64; 3], drift: [f64; 2]) -> Obstacle {
+        let data = if vessel == 0 {
+            &self.ship
+        } else {
+            &self.tugs[vessel - 1]
+        };
+        Obstacle::Ellipse {
+            centre: [pose[0], pose[1]],
+            semi_major: data.length * std::f64::consts::FRAC_1_SQRT_2,
+            semi_minor: data.width.min(data.length) * std::f64::consts::FRAC_1_SQRT_2,
+            orientation: pose[2],
+            drift,
+        }
+    }
+
+    /// The ship's hull as the tugs' local problems keep clear of it ([`FormationMap::hull`])
+    /// at the ship's present pose `ship`, moving by the mean displacement per sample of
+    /// the coordination's predicted trajectory `predicted`.
     #[must_use]
     pub fn ship_obstacle(&self, ship: &ShipState, predicted: &[ShipState; HORIZON]) -> Obstacle {
         let last = predicted[HORIZON - 1];
         let k = HORIZON as f64;
-        Obstacle::Ellipse {
-            centre: [ship[0], ship[1]],
-            semi_major: self.ship.length * std::f64::consts::FRAC_1_SQRT_2,
-            semi_minor: self.ship.width.min(self.ship.length) * std::f64::consts::FRAC_1_SQRT_2,
-            orientation: ship[2],
-            drift: [(last[0] - ship[0]) / k, (last[1] - ship[1]) / k],
-        }
+        let drift = [(last[0] - ship[0]) / k, (last[1] - ship[1]) / k];
+        self.hull(0, [ship[0], ship[1], ship[2]], drift)
+    }
+
+    /// Tug `i`'s hull as the other tug's local problem keeps clear of it
+    /// ([`FormationMap::hull`]) at its present state `tug` `[x, y, psi, u, v, r]`, moving
+    /// at its present velocity over ground for `sample_time` per sample (constant
+    /// velocity, as the targets are predicted). The two tugs plan in parallel, so each
+    /// sees the other where it is and where it is going, not where the other's new plan
+    /// will take it.
+    #[must_use]
+    pub fn tug_obstacle(&self, i: usize, tug: &[f64; 6], sample_time: f64) -> Obstacle {
+        let (sin, cos) = tug[2].sin_cos();
+        let drift = [
+            (cos * tug[3] - sin * tug[4]) * sample_time,
+            (sin * tug[3] + cos * tug[4]) * sample_time,
+        ];
+        self.hull(1 + i, [tug[0], tug[1], tug[2]], drift)
     }
 
     /// The map for a ship, the two tugs (0 = tug 1 aft, 1 = tug 2 forward) and the

@@ -70,10 +70,10 @@ pub struct TugMpcParams {
     pub clearance: ClearanceParams,
     /// Bank rows built into the problem ([`crate::ShipMpcParams::waterway_rows`]).
     pub waterway_rows: bool,
-    /// A clearance row about the tow's own ship ([`TugStepData::own_ship`]) built into
-    /// the problem (the default; not in the paper); `false` (eq. (16) as printed) builds
-    /// none.
-    pub own_ship_row: bool,
+    /// Clearance rows about the tow's own vessels ([`TugStepData::own_ship`],
+    /// [`TugStepData::other_tug`]) built into the problem (the default; not in the
+    /// paper); `false` (eq. (16) as printed) builds none.
+    pub tow_rows: bool,
     /// Largest predicted yaw rate `|r|` (rad/s): two soft rows per sample with the
     /// clearance rows' L1 penalty (per rad/s), [`tug_yaw_rate_terms`]; default 0.5 rad/s
     /// (`docs/assumptions.md`); infinite (eq. (16) as printed): no rows. Not in the paper.
@@ -95,7 +95,7 @@ impl Default for TugMpcParams {
             distance: DistanceCost::default(),
             clearance: ClearanceParams::with_min_distance(0.6),
             waterway_rows: false,
-            own_ship_row: true,
+            tow_rows: true,
             max_yaw_rate: 0.5,
         }
     }
@@ -163,11 +163,17 @@ pub struct TugStepData<'a> {
     pub waterway: Option<Waterway<'a>>,
     /// The tow's own ship as the coordination predicts it
     /// ([`crate::FormationMap::ship_obstacle`]), kept at the clearance distance by a row
-    /// of its own (with [`TugMpcParams::own_ship_row`]) and no distance cost: the tug
+    /// of its own (with [`TugMpcParams::tow_rows`]) and no distance cost: the tug
     /// works next to it, its line keeps it at the formation's distance, and only a tug
     /// driven onto the hull (dodging a target, or overrun) must be stopped. `None`: no
     /// such row (a tug alone).
     pub own_ship: Option<Obstacle>,
+    /// The tow's other tug ([`crate::FormationMap::tug_obstacle`]), kept clear the same
+    /// way: the formation keeps the tugs a ship's length and two lines apart, and only
+    /// a formation folded at close quarters (the ship turned short round, a tug dodging
+    /// a target) brings them together, which nothing else in the tug's problem sees.
+    /// `None`: no such row.
+    pub other_tug: Option<Obstacle>,
 }
 
 /// A tug's local problem (module docs).
@@ -191,7 +197,7 @@ pub struct TugLinearised {
 #[derive(Debug, Clone)]
 pub struct TugRows {
     clearance: SlotRows,
-    own_ship: SlotRows,
+    tow: SlotRows,
     bank: SlotRows,
     yaw: SlotRows,
 }
@@ -200,7 +206,7 @@ impl RowSet for TugRows {
     fn blocks(&self) -> impl Iterator<Item = Block<'_>> {
         [
             Block::Slots(&self.clearance),
-            Block::Slots(&self.own_ship),
+            Block::Slots(&self.tow),
             Block::Slots(&self.bank),
             Block::Slots(&self.yaw),
         ]
@@ -209,7 +215,7 @@ impl RowSet for TugRows {
     fn blocks_mut(&mut self) -> impl Iterator<Item = BlockMut<'_>> {
         [
             BlockMut::Slots(&mut self.clearance),
-            BlockMut::Slots(&mut self.own_ship),
+            BlockMut::Slots(&mut self.tow),
             BlockMut::Slots(&mut self.bank),
             BlockMut::Slots(&mut self.yaw),
         ]
@@ -262,8 +268,8 @@ impl Subproblem for TugProblem {
     fn rows(&self) -> TugRows {
         TugRows {
             clearance: self.params.clearance.rows(3, ALL_VESSELS),
-            own_ship: (self.params.clearance)
-                .single(self.params.own_ship_row)
+            tow: (self.params.clearance)
+                .slots(2 * usize::from(self.params.tow_rows))
                 .rows(3, ALL_VESSELS),
             bank: (self.params.clearance)
                 .single(self.params.waterway_rows)
@@ -407,15 +413,22 @@ fn accumulate(
             slots.as_deref_mut().map(|r| &mut r.clearance),
             at,
         );
-        if let (true, Some(ship)) = (params.own_ship_row, &data.own_ship) {
+        // The tow's own vessels present, in slot order (the second entry of a single one
+        // is a copy, left out).
+        let tow = match (data.own_ship, data.other_tug) {
+            (Some(a), Some(b)) => Some(([a, b], 2)),
+            (Some(a), None) | (None, Some(a)) => Some(([a, a], 1)),
+            (None, None) => None,
+        };
+        if let (true, Some((tow, n))) = (params.tow_rows, tow) {
             obstacle_terms(
                 quad,
-                std::slice::from_ref(ship),
-                1,
+                &tow[..n],
+                0b11,
                 &params.distance,
                 0.0,
                 &params.clearance,
-                slots.as_deref_mut().map(|r| &mut r.own_ship),
+                slots.as_deref_mut().map(|r| &mut r.tow),
                 at,
             );
         }
@@ -451,6 +464,7 @@ mod tests {
             distance_cost_off: 0,
             waterway: None,
             own_ship: None,
+            other_tug: None,
         }
     }
 
@@ -584,6 +598,44 @@ mod tests {
         TugMpc::new(model, params).unwrap()
     }
 
+    /// The closest the tug's plan comes to `vessel` (placed in the data by `place`)
+    /// over 40 steps towards a reference just beyond it, with the tow rows on or off.
+    fn closest_approach(
+        vessel: Obstacle,
+        place: fn(&mut TugStepData<'_>, Option<Obstacle>),
+        present: bool,
+        row: bool,
+    ) -> f64 {
+        let mut mpc = tug_mpc_with(TugMpcParams {
+            tow_rows: row,
+            ..TugMpcParams::default()
+        });
+        let mut data = data_ahead(&[]);
+        data.reference = [[1.5, 0.0, 0.0]; HORIZON];
+        place(&mut data, present.then_some(vessel));
+        for _ in 0..40 {
+            let report = mpc.step(&data);
+            assert!(report.qp.is_usable(), "{report:?}");
+            assert!(within_bounds(&mpc));
+        }
+        mpc.predicted()
+            .iter()
+            .map(|x| vessel.distance([x[0], x[1]]).0)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The plan runs onto `vessel` without it in the data or with the rows off, and
+    /// keeps `d_min` from it with both.
+    fn assert_kept_clear_of(vessel: Obstacle, place: fn(&mut TugStepData<'_>, Option<Obstacle>)) {
+        let d_min = TugMpcParams::default().clearance.min_distance;
+        let free = closest_approach(vessel, place, false, true);
+        let off = closest_approach(vessel, place, true, false);
+        let kept = closest_approach(vessel, place, true, true);
+        assert!(free < d_min - 0.05, "{free}");
+        assert!(off < d_min - 0.05, "{off}");
+        assert!(kept >= d_min - 1e-3, "{kept}");
+    }
+
     /// A reference across the tow's own ship (a towing angle swung through the hull): the
     /// own-ship row keeps the tug's plan at `d_min` from the hull ellipse, with no distance
     /// cost of its own; without the ship in the data, or with the row off, the plan runs
@@ -597,31 +649,18 @@ mod tests {
                 &[1.4, 0.0, 1.5, 0.0, 0.0, 0.0],
                 &[[1.4, 0.0, 1.5, 0.0, 0.0, 0.0]; HORIZON],
             );
-        let run = |own_ship: Option<Obstacle>, row: bool| {
-            let mut mpc = tug_mpc_with(TugMpcParams {
-                own_ship_row: row,
-                ..TugMpcParams::default()
-            });
-            let mut data = data_ahead(&[]);
-            data.reference = [[1.5, 0.0, 0.0]; HORIZON];
-            data.own_ship = own_ship;
-            for _ in 0..40 {
-                let report = mpc.step(&data);
-                assert!(report.qp.is_usable(), "{report:?}");
-                assert!(within_bounds(&mpc));
-            }
-            mpc.predicted()
-                .iter()
-                .map(|x| ship.distance([x[0], x[1]]).0)
-                .fold(f64::INFINITY, f64::min)
-        };
-        let d_min = TugMpcParams::default().clearance.min_distance;
-        let free = run(None, true);
-        let off = run(Some(ship), false);
-        let kept = run(Some(ship), true);
-        assert!(free < d_min - 0.05, "{free}");
-        assert!(off < d_min - 0.05, "{off}");
-        assert!(kept >= d_min - 1e-3, "{kept}");
+        assert_kept_clear_of(ship, |data, ship| data.own_ship = ship);
+    }
+
+    /// A reference across the other tug (the formation folded): the same with the
+    /// other tug's row, the other tug lying across the track.
+    #[test]
+    fn the_other_tug_row_keeps_the_tugs_apart() {
+        let scenario = Scenario::paper().unwrap();
+        let other = crate::FormationMap::from_scenario(&scenario)
+            .unwrap()
+            .tug_obstacle(1, &[1.4, 0.0, 1.5, 0.0, 0.0, 0.0], 1.0);
+        assert_kept_clear_of(other, |data, other| data.other_tug = other);
     }
 
     /// A heading reference a half turn away: without the limit the plan spins the tug up

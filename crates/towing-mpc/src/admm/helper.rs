@@ -57,6 +57,7 @@ struct Job {
     obstacles: Vec<Obstacle>,
     distance_cost_off: u64,
     own_ship: Option<Obstacle>,
+    other_tug: Option<Obstacle>,
     /// The lane (cloned into the kept buffer) and the margins of the sample's waterway.
     waterway: Option<(Lane, [f64; 3])>,
 }
@@ -72,6 +73,7 @@ impl Job {
         self.obstacles.extend_from_slice(d.obstacles);
         self.distance_cost_off = d.distance_cost_off;
         self.own_ship = d.own_ship;
+        self.other_tug = d.other_tug;
         // The lane is the run's, the same every step: copied only when it differs, so the
         // per-iteration hand-over allocates nothing.
         match (&mut self.waterway, d.waterway) {
@@ -95,6 +97,7 @@ impl Job {
             obstacles: &self.obstacles,
             distance_cost_off: self.distance_cost_off,
             own_ship: self.own_ship,
+            other_tug: self.other_tug,
             waterway: self.waterway.as_ref().map(|(lane, margin)| Waterway {
                 lane,
                 margin: *margin,

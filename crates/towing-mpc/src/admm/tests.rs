@@ -8,10 +8,11 @@ use super::*;
 /// term; the closed loop's default adds one, `docs/assumptions.md`).
 /// The cost as the paper prints it (eq. (13), Table 3): no terminal term, the heading
 /// weight of Table 3, no motion limits.
-/// The tug problem as printed (eq. (16)): no own-ship row, no yaw-rate rows.
+/// The tug problem as printed (eq. (16)): no rows about the tow's own vessels, no
+/// yaw-rate rows.
 pub(crate) fn printed_tug() -> TugMpcParams {
     TugMpcParams {
-        own_ship_row: false,
+        tow_rows: false,
         max_yaw_rate: f64::INFINITY,
         ..TugMpcParams::default()
     }

@@ -187,6 +187,63 @@ fn jacobians_match_finite_differences() {
     assert!(worst < 1e-6, "{worst}");
 }
 
+/// The rows keeping the tow's own vessels apart ([`TOW_PAIRS`]) against central
+/// differences of the distances they record, on the moving, turning instance of the
+/// Jacobian test (tug 2 displaced towards tug 1's side, every hull turning).
+#[test]
+fn tow_rows_match_finite_differences() {
+    let c = Centralized::from_scenario(
+        &Scenario::paper().unwrap(),
+        HullModel::NonlinearDamping,
+        PredictionParams::default(),
+        crate::admm::tests::printed_cost(),
+        TugMpcParams::default(),
+        CentralizedSettings::default(),
+    )
+    .unwrap();
+    let mut input = instance(2.0, 0.3, 0.1, 0.4);
+    input.ship[3..].copy_from_slice(&[0.15, 0.02, 0.05]);
+    input.tugs[0][3..].copy_from_slice(&[0.12, -0.03, 0.2]);
+    input.tugs[1][3..].copy_from_slice(&[0.18, 0.04, -0.15]);
+    let problem = c.scp.problem();
+    let data = CentralData::of(&input);
+    let recorded = |flat: &[f64; NU]| {
+        let (_, mut lin) = problem.buffers();
+        problem.linearise(&data, flat, &mut lin);
+        let mut rows = problem.rows();
+        let mut q = QuadModel::new(NU);
+        q.reset(false);
+        problem.terms(&mut q, &lin.traj, flat, Some((&lin, &mut rows)), &data);
+        rows.tow
+    };
+    let mut flat = [0.0; NU];
+    for (v, x) in flat.iter_mut().enumerate() {
+        *x = 0.3 * ((v as f64) * 0.7).sin();
+    }
+    let at = recorded(&flat);
+    let eps = 1e-6;
+    let (mut worst, mut largest): (f64, f64) = (0.0, 0.0);
+    for v in 0..NU {
+        let shifted = |delta: f64| {
+            let mut p = flat;
+            p[v] += delta;
+            recorded(&p)
+        };
+        let (plus, minus) = (shifted(eps), shifted(-eps));
+        for h in 0..HORIZON {
+            for j in 0..TOW_PAIRS.len() {
+                let value = |r: &SlotRows| r.recorded(h, j).expect("recorded").0;
+                let want = (value(&plus) - value(&minus)) / (2.0 * eps);
+                let got = at.recorded(h, j).expect("recorded").1[v];
+                worst = worst.max((want - got).abs());
+                largest = largest.max(want.abs());
+            }
+        }
+    }
+    assert!(largest > 1e-1, "{largest}");
+    assert!(worst < 1e-6, "{worst}");
+}
+
 /// Prints the distributed-vs-centralized comparison (measurement).
 #[test]
 #[ignore = "measurement: cargo test --release -p towing-mpc compare_print -- --ignored --nocapture"]

@@ -166,6 +166,14 @@ impl SlotRows {
         self.active.fill(false);
     }
 
+    /// The value and gradient recorded for slot `j` of sample `h` (`None`: not recorded).
+    #[must_use]
+    pub fn recorded(&self, h: usize, j: usize) -> Option<(f64, &[f64])> {
+        let k = h * self.slots + j;
+        (j < self.slots && h < self.horizon && self.active[k])
+            .then(|| (self.value[k], &self.grad[k * self.n_u..(k + 1) * self.n_u]))
+    }
+
     /// Records slot `j` of sample `h`: `value + row^T du >= bound - s` (`row` over
     /// the increments; entries beyond them are ignored). Out-of-range slots are
     /// ignored.
