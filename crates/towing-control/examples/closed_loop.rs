@@ -235,6 +235,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(v) = env("TOW_ROWS") {
         config.tuning.tug.tow_rows = v > 0.0;
     }
+    if let Some(v) = env("OTHER_TUG_ROW") {
+        config.tuning.tug.other_tug_row = v > 0.0;
+    }
     if let Some(v) = env("PT_W") {
         config.tuning.ship.weight_port_turn = v;
     }

@@ -70,10 +70,16 @@ pub struct TugMpcParams {
     pub clearance: ClearanceParams,
     /// Bank rows built into the problem ([`crate::ShipMpcParams::waterway_rows`]).
     pub waterway_rows: bool,
-    /// Clearance rows about the tow's own vessels ([`TugStepData::own_ship`],
-    /// [`TugStepData::other_tug`]) built into the problem (the default; not in the
-    /// paper); `false` (eq. (16) as printed) builds none.
+    /// Clearance rows about the tow's own vessels ([`TugStepData::own_ship`], and
+    /// [`TugStepData::other_tug`] with [`Self::other_tug_row`]) built into the problem
+    /// (the default; not in the paper); `false` (eq. (16) as printed) builds none.
     pub tow_rows: bool,
+    /// With [`Self::tow_rows`], a row about the other tug too (default `false`: off).
+    /// Tried 2026-12-06 and left off: it took the distributed runs with a collision over
+    /// the random campaign down, but with the linear prediction model against the
+    /// nonlinear plant the paper run no longer arrived (a round turn at target B, then
+    /// a stall beside hazard c; `docs/assumptions.md`).
+    pub other_tug_row: bool,
     /// Largest predicted yaw rate `|r|` (rad/s): two soft rows per sample with the
     /// clearance rows' L1 penalty (per rad/s), [`tug_yaw_rate_terms`]; default 0.5 rad/s
     /// (`docs/assumptions.md`); infinite (eq. (16) as printed): no rows. Not in the paper.
@@ -96,6 +102,7 @@ impl Default for TugMpcParams {
             clearance: ClearanceParams::with_min_distance(0.6),
             waterway_rows: false,
             tow_rows: true,
+            other_tug_row: false,
             max_yaw_rate: 0.5,
         }
     }
@@ -113,6 +120,13 @@ impl TugMpcParams {
             ],
             [self.weight_surge, self.weight_sway, self.weight_yaw_rate],
         )
+    }
+
+    /// Slots of the rows about the tow's own vessels: the own ship's, and the other
+    /// tug's with [`Self::other_tug_row`]; none without [`Self::tow_rows`].
+    #[must_use]
+    pub fn tow_slots(&self) -> usize {
+        usize::from(self.tow_rows) * (1 + usize::from(self.other_tug_row))
     }
 
     /// The yaw-rate limit and its penalty ([`tug_yaw_rate_terms`]).
@@ -269,7 +283,7 @@ impl Subproblem for TugProblem {
         TugRows {
             clearance: self.params.clearance.rows(3, ALL_VESSELS),
             tow: (self.params.clearance)
-                .slots(2 * usize::from(self.params.tow_rows))
+                .slots(self.params.tow_slots())
                 .rows(3, ALL_VESSELS),
             bank: (self.params.clearance)
                 .single(self.params.waterway_rows)
@@ -415,7 +429,8 @@ fn accumulate(
         );
         // The tow's own vessels present, in slot order (the second entry of a single one
         // is a copy, left out).
-        let tow = match (data.own_ship, data.other_tug) {
+        let other_tug = data.other_tug.filter(|_| params.other_tug_row);
+        let tow = match (data.own_ship, other_tug) {
             (Some(a), Some(b)) => Some(([a, b], 2)),
             (Some(a), None) | (None, Some(a)) => Some(([a, a], 1)),
             (None, None) => None,
@@ -608,6 +623,7 @@ mod tests {
     ) -> f64 {
         let mut mpc = tug_mpc_with(TugMpcParams {
             tow_rows: row,
+            other_tug_row: true,
             ..TugMpcParams::default()
         });
         let mut data = data_ahead(&[]);
