@@ -505,22 +505,26 @@ impl CentralProblem {
                 &traj.tugs[v - 1][h]
             }
         };
-        let rows = |v: usize| {
-            sens.map_or([[0.0; NU]; 6], |s| {
-                sens_rows(if v == 0 {
-                    &s.ship[h]
-                } else {
-                    &s.tugs[v - 1][h]
+        // Each vessel's sensitivity rows once (a vessel is in two pairs); only with rows to
+        // record.
+        let rows: Option<[[[f64; NU]; 6]; 3]> = tow.as_ref().map(|_| {
+            std::array::from_fn(|v| {
+                sens.map_or([[0.0; NU]; 6], |s| {
+                    sens_rows(if v == 0 {
+                        &s.ship[h]
+                    } else {
+                        &s.tugs[v - 1][h]
+                    })
                 })
             })
-        };
+        });
         for (j, (a, b)) in TOW_PAIRS.into_iter().enumerate() {
             let (xa, xb) = (state(a), state(b));
             let hull = self.formation.hull(b, [xb[0], xb[1], xb[2]], [0.0; 2]);
             let (d, grad) = hull.distance([xa[0], xa[1]]);
             quad.value += tp.clearance.penalty_at(d);
-            if let Some(t) = tow.as_deref_mut() {
-                let (ra, rb) = (rows(a), rows(b));
+            if let (Some(t), Some(rows)) = (tow.as_deref_mut(), &rows) {
+                let (ra, rb) = (&rows[a], &rows[b]);
                 let turn = grad[0] * (xa[1] - xb[1]) - grad[1] * (xa[0] - xb[0]);
                 let row: [f64; NU] = std::array::from_fn(|k| {
                     grad[0] * (ra[0][k] - rb[0][k])

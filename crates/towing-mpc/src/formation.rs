@@ -11,6 +11,7 @@
 //! headings; `formation_pose` wraps it to `(-pi, pi]` (equal modulo `2 pi`).
 
 use nalgebra::Matrix3x4;
+use towing_model::geometry::body_to_ned;
 use towing_model::towline::formation_pose;
 use towing_model::{ParamError, Scenario, VesselData};
 
@@ -68,11 +69,8 @@ impl FormationMap {
     /// will take it.
     #[must_use]
     pub fn tug_obstacle(&self, i: usize, tug: &[f64; 6], sample_time: f64) -> Obstacle {
-        let (sin, cos) = tug[2].sin_cos();
-        let drift = [
-            (cos * tug[3] - sin * tug[4]) * sample_time,
-            (sin * tug[3] + cos * tug[4]) * sample_time,
-        ];
+        // The body velocity over a sample, rotated into NED.
+        let drift = body_to_ned(0.0, 0.0, tug[2], tug[3] * sample_time, tug[4] * sample_time);
         self.hull(1 + i, [tug[0], tug[1], tug[2]], drift)
     }
 

@@ -166,9 +166,11 @@ impl SlotRows {
         self.active.fill(false);
     }
 
-    /// The value and gradient recorded for slot `j` of sample `h` (`None`: not recorded).
+    /// The value and gradient recorded for slot `j` of sample `h` (`None`: not recorded);
+    /// for the tests' finite-difference checks.
+    #[cfg(test)]
     #[must_use]
-    pub fn recorded(&self, h: usize, j: usize) -> Option<(f64, &[f64])> {
+    pub(crate) fn recorded(&self, h: usize, j: usize) -> Option<(f64, &[f64])> {
         let k = h * self.slots + j;
         (j < self.slots && h < self.horizon && self.active[k])
             .then(|| (self.value[k], &self.grad[k * self.n_u..(k + 1) * self.n_u]))
