@@ -105,7 +105,9 @@ pub struct GuidanceSettings {
     pub acceptance_radius: f64,
     /// Also advance when the ship has passed the reference waypoint: its
     /// projection on the segment from `W_{p-1}` to the reference waypoint reaches
-    /// the segment's length (the ship is beyond the waypoint's normal line).
+    /// the segment's length (the ship is beyond the waypoint's normal line), or she
+    /// is past the bisector of the route's turn at the waypoint
+    /// (`ReferenceSystem::reached`).
     ///
     /// Assumption: `true`. After an avoidance the ship may pass beside the waypoint,
     /// outside the acceptance radius; without this it would turn back for it.

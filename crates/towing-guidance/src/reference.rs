@@ -771,7 +771,23 @@ impl ReferenceSystem {
         }
     }
 
-    fn reached(&self, ship: [f64; 2], p: usize, target: Pose) -> bool {
+    /// Whether the ship has reached the reference waypoint `target` of segment `p`:
+    /// within the acceptance radius, or (with `advance_on_passing`) past it: past the
+    /// line square to the segment at `target`, or, at a turn, past the line that
+    /// bisects the turn there (the one through `target` square to the sum of the
+    /// two legs' unit directions). A ship that cuts inside a turn, as the
+    /// lookahead leads her to, reaches the next leg short of the first line: her
+    /// tracked point, placed on the next leg the lookahead beyond the waypoint,
+    /// then lay abeam of her, and she lay stopped beside it (random-12-0209:
+    /// 300 s, 0.25 m short of the line after an 88 deg turn). The bisector is the
+    /// usual switching line of waypoint guidance where legs meet at an angle
+    /// (Fossen 2021, *Handbook of Marine Craft Hydrodynamics and Motion Control*,
+    /// 2nd ed., section 12.4, on the circle of acceptance and switching; the
+    /// bisector is the locus of points equally far from both legs' lines). On a
+    /// straight run-on both lines are one. Not on an `altered` leg: its reference
+    /// waypoint is a direction the tracked point runs on past, not a turn, and a
+    /// bisector at the rotated waypoint ended the alteration early (random-12-0084).
+    fn reached(&self, ship: [f64; 2], p: usize, target: Pose, altered: bool) -> bool {
         let s = self.params.settings();
         if dist(ship, target.position()) <= s.acceptance_radius {
             return true;
@@ -779,11 +795,25 @@ impl ReferenceSystem {
         if !s.advance_on_passing {
             return false;
         }
-        let prev = self.route.points()[p - 1];
-        let seg = [target.x - prev.x, target.y - prev.y];
-        let r = seg[0].hypot(seg[1]);
-        let along = ((ship[0] - prev.x) * seg[0] + (ship[1] - prev.y) * seg[1]) / r;
-        along >= r
+        let points = self.route.points();
+        let unit = |from: [f64; 2], to: [f64; 2]| {
+            let d = [to[0] - from[0], to[1] - from[1]];
+            let r = d[0].hypot(d[1]);
+            (r > 0.0).then(|| [d[0] / r, d[1] / r])
+        };
+        let at = target.position();
+        let rel = [ship[0] - at[0], ship[1] - at[1]];
+        let passed = |n: [f64; 2]| rel[0] * n[0] + rel[1] * n[1] >= 0.0;
+        let Some(e1) = unit(points[p - 1].position(), at) else {
+            return false;
+        };
+        let bisector = (!altered)
+            .then(|| points.get(p + 1))
+            .flatten()
+            .and_then(|next| unit(at, next.position()))
+            .map(|e2| [e1[0] + e2[0], e1[1] + e2[1]])
+            .filter(|n| n[0].hypot(n[1]) > 1e-9);
+        passed(e1) || bisector.is_some_and(passed)
     }
 
     /// Steps 2 and 3 of the module doc for one assessed obstacle: what the next sample
@@ -956,7 +986,7 @@ impl ReferenceSystem {
         let ship = tow.ship.position();
         let last = self.route.last_index();
         let (mut target, mut theta) = self.reference(self.active, altered);
-        while self.active < last && self.reached(ship, self.active, target) {
+        while self.active < last && self.reached(ship, self.active, target, altered) {
             self.active += 1;
             (target, theta) = self.reference(self.active, altered);
         }
@@ -1795,6 +1825,32 @@ mod tests {
             .unwrap();
         assert_eq!(out.active_waypoint, 2);
         assert_eq!(out.eta_sd, Pose::new(60.0, 0.0, 0.0));
+    }
+
+    #[test]
+    fn a_ship_cutting_inside_a_turn_advances_at_the_bisector() {
+        // North 30 m, then a 90 deg turn to starboard (East) for 30 m.
+        let route = Route::from_positions(&[[0.0, 0.0], [30.0, 0.0], [30.0, 30.0]]).unwrap();
+        // Inside the turn, 0.5 m short of W_1's normal line and 1.4 m past its
+        // bisector (the line through W_1 at 45 deg), 2.55 m from W_1: outside the
+        // acceptance radius and short of the first leg's end, but nearer the second
+        // leg's line than the first's.
+        let ship = Pose::new(29.5, 2.5, std::f64::consts::FRAC_PI_2);
+        let mut rs = ReferenceSystem::new(route.clone(), GuidanceParams::default());
+        assert_eq!(
+            rs.update(&tow_at(ship, 0.1), &[]).unwrap().active_waypoint,
+            2
+        );
+        // Short of both lines (2 m short of the normal, 1.5 m inside the first leg,
+        // 0.35 m short of the bisector) it does not advance yet.
+        let mut rs = ReferenceSystem::new(route, GuidanceParams::default());
+        let before = Pose::new(28.0, 1.5, 0.0);
+        assert_eq!(
+            rs.update(&tow_at(before, 0.1), &[])
+                .unwrap()
+                .active_waypoint,
+            1
+        );
     }
 
     #[test]
