@@ -807,9 +807,9 @@ impl ReferenceSystem {
         let Some(e1) = unit(points[p - 1].position(), at) else {
             return false;
         };
-        let bisector = (!altered)
-            .then(|| points.get(p + 1))
-            .flatten()
+        let bisector = points
+            .get(p + 1)
+            .filter(|_| !altered)
             .and_then(|next| unit(at, next.position()))
             .map(|e2| [e1[0] + e2[0], e1[1] + e2[1]])
             .filter(|n| n[0].hypot(n[1]) > 1e-9);
