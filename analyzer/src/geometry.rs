@@ -7,8 +7,8 @@
 use std::f64::consts::PI;
 
 pub use towing_model::geometry::{
-    body_to_ned, crossed_ahead, dist, line_coordinates, segment_projection, HullRect, Lane,
-    Polyline, Projection,
+    body_to_ned, crossed_ahead, dist, drawing_away, line_coordinates, segment_projection, HullRect,
+    Lane, Polyline, Projection,
 };
 
 /// A point `[north, east]`, m.

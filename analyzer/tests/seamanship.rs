@@ -907,3 +907,44 @@ fn seamanship_a_stand_on_departure_made_while_acting_for_another_target_is_excus
     assert!((470.0..=471.0).contains(&t), "{t}");
     assert!(metrics(&verdict(&r)).contains(&"rule17_stand_on"));
 }
+
+#[test]
+fn seamanship_a_target_drawing_ahead_along_the_heading_line_is_gone() {
+    // Rule 8(d), "gone": a target whose track runs parallel to the ship's heading line
+    // never meets it. Until 2026-12-07 the test asked that the target's own velocity
+    // carry it away from the line on its side, which a target on a parallel course does
+    // not, so a tow that stopped for a slower vessel she was overtaking and let it draw
+    // ahead was judged to have given up when she went on. Here the target, 0.3 m to
+    // starboard of the route, northbound at 0.04 m/s, is overtaken by the tow at cruise
+    // (0.065 m/s); the tow stops from 140 s to 300 s.
+    let ahead = Target {
+        name: "ahead",
+        at_t0: [12.0, 0.3],
+        course_deg: 0.0,
+        speed: 0.04,
+    };
+    let stop = |t: f64, p: [f64; 2]| {
+        if t > 140.0 && t <= 300.0 {
+            (0.0, 0.0, 0.0)
+        } else {
+            cruise(t, p)
+        }
+    };
+    let r = run(600.0, stop, no_offset, &[ahead]);
+    let target = &r.rules.targets[0];
+    assert_eq!(
+        target.situation.as_deref(),
+        Some("overtaking"),
+        "{target:?}"
+    );
+    assert!(target.t_detect_s.is_some_and(|t| t < 140.0), "{target:?}");
+    assert_eq!(
+        target.past_and_clear.as_deref(),
+        Some("gone beyond the detection distance, drawing away"),
+        "{target:?}"
+    );
+    let t_clear = target.t_past_and_clear_s.expect("past");
+    assert!((140.0..300.0).contains(&t_clear), "{t_clear}");
+    assert!(target.given_up.is_none(), "{target:?}");
+    assert!(!metrics(&verdict(&r)).contains(&"rule8_past_and_clear"));
+}

@@ -49,9 +49,9 @@
 //! motion alone makes the crossing, and the verdict does not depend on the step size); in
 //! any situation, it is abaft the ship's
 //! beam with the range opening while the tow makes way (surge > `way_off_surge_m_s`), or
-//! it has gone: beyond `d_detect` of every vessel of the tow, on the side of the ship's
-//! heading line its own velocity carries it away from, that velocity opening the range
-//! from the ship (its track no longer meets the heading line ahead of her, and the range
+//! it has gone: beyond `d_detect` of every vessel of the tow and drawing away
+//! ([`crate::geometry::drawing_away`]: its own velocity opens the range from the ship and
+//! its track no longer meets her heading line ahead of her; the range
 //! is the target's doing, not the tow's braking: a crossing target the tow let pass by
 //! turning away from it and stopping, which the guidance releases once it has left the
 //! encounter distance, `docs/colregs.md`). A
@@ -68,7 +68,7 @@ use crate::doc::Block;
 use crate::error::Result;
 
 use crate::geometry::{
-    course_velocity, cpa_tcpa, crossed_ahead, hull_ellipse_clearance, line_coordinates, range_rate,
+    course_velocity, cpa_tcpa, crossed_ahead, drawing_away, hull_ellipse_clearance, line_coordinates, range_rate,
 };
 use crate::rows::VESSELS;
 use crate::colregs::{classify, Situation};
@@ -455,13 +455,10 @@ impl Target {
         let opening = range_rate(sp, ship.vel_n(), tp, v_target) > 0.0;
         let abaft =
             beta.abs() > std::f64::consts::FRAC_PI_2 && opening && ship.u > th.way_off_surge_m_s;
-        // Gone: beyond d_detect of every vessel of the tow, on the side of the ship's
-        // heading line its own velocity carries it away from, and that velocity opening
-        // the range from the ship: its track no longer meets the tow's heading line
-        // ahead of her, and neither the tow's braking nor her sternway made the range.
-        let (side, drift) = side_and_drift(ship, o);
-        let away = range_rate(sp, [0.0, 0.0], tp, v_target) > 0.0;
-        let gone = !any_within(vessels, tp, d_detect) && side * drift > 0.0 && away;
+        // Gone: beyond d_detect of every vessel of the tow, its own velocity opening the
+        // range from the ship and its track no longer meeting her heading line ahead of
+        // her; neither the tow's braking nor her sternway made the range.
+        let gone = !any_within(vessels, tp, d_detect) && drawing_away(sp, ship.psi, tp, v_target);
         if crossed || abaft || gone {
             self.r.t_past_and_clear_s = Some(t);
             self.r.past_and_clear = Some(

@@ -33,7 +33,7 @@
 //!    and beyond that vessel's eq. (14) safe range plus `release_margin`) and the tow
 //!    resuming her route would pass it clear ([`resume_clear`]); or until it has left
 //!    (beyond the distance plus `release_margin`, not closing, clear of the resumed
-//!    track), even if its situation has meanwhile become safe. An encounter found past
+//!    track, and drawing away: [`towing_model::geometry::drawing_away`]), even if its situation has meanwhile become safe. An encounter found past
 //!    and clear stays over until the target leaves the encounter distance, unless it
 //!    closes again into a situation in which Rule 17 would act (its TCPA and DCPA
 //!    limits).
@@ -164,6 +164,11 @@ pub struct ObstacleAssessment {
     /// velocity over ground; at rest once she has taken the way off):
     /// [`clearance_margin`] at least 0. False otherwise.
     pub passes_clear: bool,
+    /// A target ship drawing away: its own velocity carries it away from the ship's
+    /// heading line on the side it lies and opens the range from her
+    /// ([`towing_model::geometry::drawing_away`], the analyzer's test too): its track
+    /// no longer meets her heading line ahead. True for a static hazard.
+    pub drawing_away: bool,
 }
 
 /// What the reference system knows beyond the obstacle and the tow.
@@ -325,6 +330,15 @@ pub fn assess_obstacle(
         }
         ActiveObstacle::Circle { .. } => false,
     };
+    let drawing_away = match obstacle {
+        ActiveObstacle::Vessel(target) => towing_model::geometry::drawing_away(
+            tow.ship.position(),
+            tow.ship.psi,
+            target.centre,
+            target.velocity(),
+        ),
+        ActiveObstacle::Circle { .. } => true,
+    };
     ObstacleAssessment {
         index,
         kind: obstacle.kind(),
@@ -342,6 +356,7 @@ pub fn assess_obstacle(
         manoeuvre,
         resume_clear,
         passes_clear,
+        drawing_away,
     }
 }
 
@@ -843,12 +858,14 @@ impl ReferenceSystem {
         // its own motion, or is abaft her beam, and the range is opening and safe from
         // every vessel) and the tow resuming her route would pass it clear (else she
         // would turn or run back into a close-quarters situation with it); or until the
-        // target has left: beyond the encounter distance, no longer closing, and clear
-        // of the resumed track. A range opened by the tow's own braking or turning
+        // target has left: beyond the encounter distance, no longer closing, clear of
+        // the resumed track, and drawing away (its track no longer meets the ship's
+        // heading line ahead: "not closing" is judged with the tow's own velocity, and a
+        // stopped tow finds every moving target not closing). A range opened by the tow's own braking or turning
         // releases nothing while her resumed track would bring her back to it.
         let closing = a.encounter.is_some_and(|e| e.cpa.is_closing());
         let finally_clear = a.past_and_clear && a.resume_clear;
-        let left = !near && !closing && a.resume_clear;
+        let left = !near && !closing && a.resume_clear && a.drawing_away;
         let holds = context.acting && !finally_clear && !left;
         if a.manoeuvre == Manoeuvre::TakeWayOff || (slowed && holds) {
             next.way_off |= bit;
@@ -1177,6 +1194,34 @@ mod tests {
         let out = rs.update(&tow, &at(7.3)).unwrap();
         assert!(!out.altered);
         assert_eq!(out.governing.unwrap().situation, Some(Situation::HeadOn));
+    }
+
+    #[test]
+    fn a_give_way_alteration_is_held_until_a_target_beyond_the_distance_draws_away() {
+        // The tow stopped, giving way to a target crossing from starboard
+        // (random-12-0238 at its release).
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let tow = tow_at(Pose::new(2.0, 0.0, 0.0), 0.0);
+        let near = vessel(tow.tug2.x + 4.0, 3.0, -PI / 2.0, 0.1);
+        let out = rs.update(&tow, &[near]).unwrap();
+        assert!(out.altered);
+        assert_eq!(rs.situation(0), Some(Situation::CrossingGiveWay));
+        // 8 m ahead of the forward tug and 0.5 m to starboard, beyond d_D + 0.5 m, heading
+        // 30 deg to port of her heading: the range opens (the tow is stopped, so not
+        // closing) and her resumed track passes it clear, but its track still meets her
+        // heading line ahead of her: the alteration is held.
+        let crossing = vessel(tow.tug2.x + 8.0, 0.5, deg(-30.0), 0.07);
+        let out = rs.update(&tow, &[crossing]).unwrap();
+        let g = out.governing.unwrap();
+        assert!(!g.detected && !g.past_and_clear && g.resume_clear && !g.drawing_away);
+        assert!(out.altered);
+        // The same target turned away to starboard, 30 deg off her heading: drawing away
+        // without crossing her line, it has left.
+        let away = vessel(tow.tug2.x + 8.0, 0.5, deg(30.0), 0.07);
+        let out = rs.update(&tow, &[away]).unwrap();
+        let g = out.governing.unwrap();
+        assert!(!g.crossed && !g.past_and_clear && g.drawing_away);
+        assert!(!out.altered);
     }
 
     #[test]

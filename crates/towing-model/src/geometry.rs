@@ -67,6 +67,26 @@ pub fn crossed_ahead(before: LineSighting, now: LineSighting) -> bool {
         && own_change.abs() >= 0.5 * change.abs()
 }
 
+/// COLREGS Rule 8(d), a target *drawing away*: its own velocity `v_target` opens the
+/// range from own ship (`v_target . (p_target - p_own) > 0`) and its track no longer
+/// meets own ship's heading line (through `own` along `course`) ahead of her: it moves
+/// away from the line on the side it lies, or parallel to it, or meets it astern of her.
+/// Only the target's motion is used, so neither her braking nor her sternway makes it.
+/// With the distance at which an encounter begins, the "gone" test of past and clear;
+/// the one test of the guidance's release (`towing_guidance`) and of the analyzer's
+/// Rule 8 check.
+#[must_use]
+pub fn drawing_away(own: Point, course: f64, target: Point, v_target: Point) -> bool {
+    let (along, side) = line_coordinates(own, course, target);
+    let (v_along, drift) = line_coordinates([0.0, 0.0], course, v_target);
+    let opening = v_target[0] * (target[0] - own[0]) + v_target[1] * (target[1] - own[1]);
+    let meets_ahead = drift != 0.0 && {
+        let t = -side / drift;
+        t >= 0.0 && along + t * v_along > 0.0
+    };
+    opening > 0.0 && !meets_ahead
+}
+
 /// Body point `(bx forward, by starboard)` of a vessel at `(x, y, psi)`, in NED
 /// (the rotation `R(psi)` of Fossen 2021, eq. (2.18), in the plane).
 #[must_use]
@@ -406,6 +426,28 @@ mod tests {
         };
         let steps = (60.0 / dt).round() as usize;
         (1..=steps).any(|k| crossed_ahead(at((k - 1) as f64 * dt), at(k as f64 * dt)))
+    }
+
+    #[test]
+    fn a_target_draws_away_only_once_its_track_no_longer_meets_the_heading_line_ahead() {
+        // Own ship at the origin heading North; the target 9 m ahead, 0.5 m to starboard.
+        let ahead = [9.0, 0.5];
+        let v = |course_deg: f64| {
+            let (s, c) = course_deg.to_radians().sin_cos();
+            [0.07 * c, 0.07 * s]
+        };
+        // Crossing to port ahead of her, moving away (random-12-0238 at its release):
+        // the range opens but its track still meets her heading line 9 m ahead.
+        assert!(!drawing_away([0.0, 0.0], 0.0, ahead, v(-30.0)));
+        // Moving away to starboard, or straight ahead of her along the line: clear.
+        assert!(drawing_away([0.0, 0.0], 0.0, ahead, v(30.0)));
+        assert!(drawing_away([0.0, 0.0], 0.0, [9.0, 0.0], v(0.0)));
+        // Coming towards her: the range closes.
+        assert!(!drawing_away([0.0, 0.0], 0.0, ahead, v(180.0)));
+        // Abaft her beam on the starboard quarter, crossing her line astern: clear.
+        assert!(drawing_away([0.0, 0.0], 0.0, [-3.0, 2.0], v(-150.0)));
+        // On her port bow drawing away to port, whatever her own speed: clear.
+        assert!(drawing_away([0.0, 0.0], 0.0, [6.0, -4.0], v(-60.0)));
     }
 
     #[test]
