@@ -67,12 +67,12 @@ use super::{FinishContext, Metric, Metrics, ReportPart, RunContext, Shared, Step
 use crate::doc::Block;
 use crate::error::Result;
 
+use crate::colregs::{classify, Situation};
 use crate::geometry::{
-    course_velocity, cpa_tcpa, crossed_ahead, drawing_away, hull_ellipse_clearance, line_coordinates, range_rate,
+    course_velocity, cpa_tcpa, crossed_ahead, dist, drawing_away, hull_ellipse_clearance,
+    line_coordinates, range_rate, relative_bearing, wrap, RouteCourse,
 };
 use crate::rows::VESSELS;
-use crate::colregs::{classify, Situation};
-use crate::geometry::{dist, relative_bearing, wrap, RouteCourse};
 use crate::step::{Obstacle, ObstacleKind, PlantStep, RunGeometry, Vessel};
 use crate::thresholds::Thresholds;
 use crate::verdict::Reason;
