@@ -33,10 +33,10 @@
 //!    and beyond that vessel's eq. (14) safe range plus `release_margin`) and the tow
 //!    resuming her route would pass it clear ([`resume_clear`]); or until it has left
 //!    (beyond the distance plus `release_margin`, not closing, clear of the resumed
-//!    track, and drawing away: [`towing_model::geometry::drawing_away`]), even if its situation has meanwhile become safe. An encounter found past
-//!    and clear stays over until the target leaves the encounter distance, unless it
-//!    closes again into a situation in which Rule 17 would act (its TCPA and DCPA
-//!    limits).
+//!    track, and drawing away: [`towing_model::geometry::drawing_away`]), even if its
+//!    situation has meanwhile become safe. An encounter found past and clear stays
+//!    over until the target leaves the encounter distance, unless it closes again
+//!    into a situation in which Rule 17 would act (its TCPA and DCPA limits).
 //! 4. While any obstacle keeps it, the reference is the active waypoint rotated to
 //!    starboard about the previous predefined waypoint (eq. (10)-(11)); otherwise the
 //!    predefined waypoint (eq. (8), `eta_Sd = eta_Sp`). An alteration whose encounters
@@ -861,8 +861,9 @@ impl ReferenceSystem {
         // target has left: beyond the encounter distance, no longer closing, clear of
         // the resumed track, and drawing away (its track no longer meets the ship's
         // heading line ahead: "not closing" is judged with the tow's own velocity, and a
-        // stopped tow finds every moving target not closing). A range opened by the tow's own braking or turning
-        // releases nothing while her resumed track would bring her back to it.
+        // stopped tow finds every moving target not closing). A range opened by the
+        // tow's own braking or turning releases nothing while her resumed track would
+        // bring her back to it.
         let closing = a.encounter.is_some_and(|e| e.cpa.is_closing());
         let finally_clear = a.past_and_clear && a.resume_clear;
         let left = !near && !closing && a.resume_clear && a.drawing_away;
