@@ -7,8 +7,8 @@
 use std::f64::consts::PI;
 
 pub use towing_model::geometry::{
-    body_to_ned, crossed_ahead, dist, drawing_away, line_coordinates, segment_projection, HullRect,
-    Lane, Polyline, Projection,
+    abaft_and_opening, body_to_ned, crossed_ahead, dist, drawing_away, line_coordinates,
+    segment_projection, HullRect, Lane, Polyline, Projection,
 };
 
 /// A point `[north, east]`, m.
@@ -170,19 +170,6 @@ pub fn cpa_tcpa(p_own: P2, v_own: P2, p_target: P2, v_target: P2) -> (f64, f64) 
     }
     let t = -(p[0] * v[0] + p[1] * v[1]) / v2;
     (t, (p[0] + t * v[0]).hypot(p[1] + t * v[1]))
-}
-
-/// Range rate of the target seen from own ship, `(p . v) / |p|` (m/s, > 0: opening).
-#[must_use]
-pub fn range_rate(p_own: P2, v_own: P2, p_target: P2, v_target: P2) -> f64 {
-    let p = [p_target[0] - p_own[0], p_target[1] - p_own[1]];
-    let v = [v_target[0] - v_own[0], v_target[1] - v_own[1]];
-    let r = p[0].hypot(p[1]);
-    if r > 0.0 {
-        (p[0] * v[0] + p[1] * v[1]) / r
-    } else {
-        0.0
-    }
 }
 
 /// Velocity `[north, east]` of a vessel on `course` (rad) at `speed` (m/s).

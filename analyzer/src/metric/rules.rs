@@ -48,7 +48,9 @@
 //! of its side, [`crate::geometry::crossed_ahead`]: neither the tow's turn nor its sideways
 //! motion alone makes the crossing, and the verdict does not depend on the step size); in
 //! any situation, it is abaft the ship's
-//! beam with the range opening while the tow makes way (surge > `way_off_surge_m_s`), or
+//! beam with the range opening ([`crate::geometry::abaft_and_opening`], the test by which
+//! the controller lets a passed target go) while the tow makes way (surge >
+//! `way_off_surge_m_s`), or
 //! it has gone: beyond `d_detect` of every vessel of the tow and drawing away
 //! ([`crate::geometry::drawing_away`]: its own velocity opens the range from the ship and
 //! its track no longer meets her heading line ahead of her; the range
@@ -69,8 +71,8 @@ use crate::error::Result;
 
 use crate::colregs::{classify, Situation};
 use crate::geometry::{
-    course_velocity, cpa_tcpa, crossed_ahead, dist, drawing_away, hull_ellipse_clearance,
-    line_coordinates, range_rate, relative_bearing, wrap, RouteCourse,
+    abaft_and_opening, course_velocity, cpa_tcpa, crossed_ahead, dist, drawing_away, hull_ellipse_clearance,
+    line_coordinates, relative_bearing, wrap, RouteCourse,
 };
 use crate::rows::VESSELS;
 use crate::step::{Obstacle, ObstacleKind, PlantStep, RunGeometry, Vessel};
@@ -450,11 +452,9 @@ impl Target {
         let before = self.crossed_before.take().is_some();
         let crossed =
             crossing && (before || prev.is_some_and(|p| crossed_ahead(p, (sp, ship.psi, tp))));
-        let beta = relative_bearing(sp, ship.psi, tp);
         let v_target = course_velocity(o.course, o.speed);
-        let opening = range_rate(sp, ship.vel_n(), tp, v_target) > 0.0;
-        let abaft =
-            beta.abs() > std::f64::consts::FRAC_PI_2 && opening && ship.u > th.way_off_surge_m_s;
+        let abaft = abaft_and_opening(sp, ship.psi, ship.vel_n(), tp, v_target)
+            && ship.u > th.way_off_surge_m_s;
         // Gone: beyond d_detect of every vessel of the tow, its own velocity opening the
         // range from the ship and its track no longer meeting her heading line ahead of
         // her; neither the tow's braking nor her sternway made the range.

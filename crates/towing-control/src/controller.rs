@@ -37,7 +37,7 @@ use towing_guidance::{
     body_to_ned, role, segment_distance, ActiveObstacle, GuidanceOutput, GuidanceParams,
     ReferenceSystem, Role, Situation, TowState,
 };
-use towing_model::geometry::Lane;
+use towing_model::geometry::{abaft_and_opening, Lane};
 use towing_model::{
     wrap_angle, ObstacleKind, ObstacleSlot, Pose, VesselData, VesselState, World, MAX_OBSTACLES,
 };
@@ -1200,7 +1200,9 @@ impl Controller {
     /// Copies the nearest obstacles (by range from the tow) into the MPC's list;
     /// returns how many, and which of them the distance cost leaves out: in schemes
     /// I and II, the targets the tow stands on until Rule 17 allows action
-    /// ([`towing_guidance::ReferenceSystem::stands_on`]; their clearance rows stay).
+    /// ([`towing_guidance::ReferenceSystem::stands_on`]) and the target ships past
+    /// their closest approach abaft the beam ([`Controller::passed_abaft`]); their
+    /// clearance rows stay.
     fn select_obstacles(&mut self, m: &Measurement) -> (usize, u64) {
         let t = &self.config.tuning;
         let slots = t
@@ -1235,11 +1237,27 @@ impl Controller {
         let alters = self.config.tuning.scheme.alters();
         for (j, &(_, k)) in candidates[..used].iter().enumerate() {
             self.mpc_obstacles[j] = mpc_obstacle(&m.obstacles[k], ts);
-            if alters && self.guidance.stands_on(k) {
+            if alters && (self.guidance.stands_on(k) || Self::passed_abaft(m, &m.obstacles[k])) {
                 off |= 1 << j;
             }
         }
         (used, off)
+    }
+
+    /// Whether target ship `o` is past its closest approach abaft the ship's beam: abaft
+    /// the beam with the range opening ([`towing_model::geometry::abaft_and_opening`],
+    /// the ship's ground velocity). The distance cost leaves it out (`docs/colregs.md`,
+    /// section 4, "Passed abaft the beam"); its clearance rows stay.
+    fn passed_abaft(m: &Measurement, o: &ObstacleSlot) -> bool {
+        let [x, y, psi, u, v, _] = m.ship;
+        o.kind == ObstacleKind::VesselEllipse
+            && abaft_and_opening(
+                [x, y],
+                psi,
+                body_to_ned(psi, u, v),
+                [o.x, o.y],
+                [o.speed * o.psi.cos(), o.speed * o.psi.sin()],
+            )
     }
 
     /// The predicted states of the applied command: the plan's (finite, checked

@@ -199,6 +199,44 @@ fn scheme_three_tracks_the_unaltered_route_and_scheme_two_drops_the_distance_cos
     assert_eq!(one.role[3], Some(Role::GiveWay));
 }
 
+/// A target ship passing port to port on the reciprocal course, 2 m abeam to port:
+/// forward of the beam and closing it keeps its distance cost; once abaft the beam with
+/// the range opening (past its closest approach) the distance cost leaves it out, in
+/// schemes I and II, and keeps it in scheme III (no alteration to stand in for it).
+#[test]
+fn a_target_passed_abaft_the_beam_leaves_the_distance_cost() {
+    let (scenario, m) = paper_measurement();
+    let psi = m.ship[2];
+    let at = |fwd: f64| {
+        let mut m = alone(m);
+        let port = -2.0;
+        m.obstacles[3] = ObstacleSlot {
+            x: m.ship[0] + fwd * psi.cos() - port * psi.sin(),
+            y: m.ship[1] + fwd * psi.sin() + port * psi.cos(),
+            psi: psi + std::f64::consts::PI,
+            speed: 0.1,
+            length: 1.48,
+            width: 0.48,
+            kind: ObstacleKind::VesselEllipse,
+        };
+        m
+    };
+    let mask = |scheme, m: &Measurement| {
+        let mut config = ControllerConfig::new(scenario.clone());
+        config.tuning.scheme = scheme;
+        let mut c = Controller::new(config).unwrap();
+        c.sample(m).unwrap();
+        let input = c.last_mpc_input().unwrap();
+        assert_eq!(input.obstacles().len(), 1);
+        input.distance_cost_off & 1
+    };
+    for scheme in [AvoidanceScheme::AlterAndCost, AvoidanceScheme::AlterOnly] {
+        assert_eq!(mask(scheme, &at(3.0)), 0, "{scheme:?} forward of the beam");
+        assert_eq!(mask(scheme, &at(-0.5)), 1, "{scheme:?} abaft the beam");
+    }
+    assert_eq!(mask(AvoidanceScheme::CostOnly, &at(-0.5)), 0);
+}
+
 /// The ship 4 m to port of her first leg, heading along it: the line of sight to the
 /// tracked point lies about 50 deg to starboard. The reference course turns towards it
 /// by at most `course_rate * T_s` per sample, stays within `course_lead` of the

@@ -87,6 +87,25 @@ pub fn drawing_away(own: Point, course: f64, target: Point, v_target: Point) -> 
     opening > 0.0 && !meets_ahead
 }
 
+/// A target *abaft the beam and opening*: it lies behind own ship's beam line (through
+/// `own` square to `heading`) and the relative velocity `v_target - v_own` opens the
+/// range (`(p_target - p_own) . (v_target - v_own) > 0`): past its closest approach and
+/// drawing aft. COLREGS Rule 8(d)'s "past" in any situation (`docs/colregs.md`,
+/// section 2); the analyzer's Rule 8 check and the controller's distance-cost mask
+/// (section 4) use this one test.
+#[must_use]
+pub fn abaft_and_opening(
+    own: Point,
+    heading: f64,
+    v_own: Point,
+    target: Point,
+    v_target: Point,
+) -> bool {
+    let (along, _) = line_coordinates(own, heading, target);
+    let (dx, dy) = (target[0] - own[0], target[1] - own[1]);
+    along < 0.0 && dx * (v_target[0] - v_own[0]) + dy * (v_target[1] - v_own[1]) > 0.0
+}
+
 /// Body point `(bx forward, by starboard)` of a vessel at `(x, y, psi)`, in NED
 /// (the rotation `R(psi)` of Fossen 2021, eq. (2.18), in the plane).
 #[must_use]
@@ -448,6 +467,41 @@ mod tests {
         assert!(drawing_away([0.0, 0.0], 0.0, [-3.0, 2.0], v(-150.0)));
         // On her port bow drawing away to port, whatever her own speed: clear.
         assert!(drawing_away([0.0, 0.0], 0.0, [6.0, -4.0], v(-60.0)));
+    }
+
+    #[test]
+    fn a_target_is_abaft_and_opening_only_behind_the_beam_with_the_range_opening() {
+        // Own ship at the origin heading North at 0.1 m/s; a head-on target passing
+        // port to port at 0.1 m/s (course South), 2 m to port.
+        let (own, v_own, v_south) = ([0.0, 0.0], [0.1, 0.0], [-0.1, 0.0]);
+        // Forward of the beam, closing: not yet.
+        assert!(!abaft_and_opening(own, 0.0, v_own, [3.0, -2.0], v_south));
+        // Abaft the beam: past its closest approach, the range opening.
+        assert!(abaft_and_opening(own, 0.0, v_own, [-0.5, -2.0], v_south));
+        // Abaft the beam but closing (an overtaking vessel coming up on the quarter).
+        assert!(!abaft_and_opening(
+            own,
+            0.0,
+            v_own,
+            [-3.0, -2.0],
+            [0.2, 0.0]
+        ));
+        // The heading, not the course made good, defines the beam: the same point is
+        // forward of the beam of a ship heading South-West and abaft it heading East.
+        assert!(!abaft_and_opening(
+            own,
+            1.25 * PI,
+            v_own,
+            [-0.5, -2.0],
+            v_south
+        ));
+        assert!(abaft_and_opening(
+            own,
+            0.5 * PI,
+            v_own,
+            [-0.5, -2.0],
+            v_south
+        ));
     }
 
     #[test]
