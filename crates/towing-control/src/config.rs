@@ -188,10 +188,11 @@ pub struct TrackingParams {
     /// 8(e), Rule 16) so the target crosses ahead and the tow passes astern.
     pub give_way_lookahead: f64,
     /// The tow keeps the way off while giving way in a crossing (`give_way_surge`,
-    /// `give_way_deceleration`); `false` (the default): the motion limits' own surge
-    /// limit only (`docs/assumptions.md`: with it the random encounters pass more
-    /// often, but the paper scenario's distributed scheme I breaks its 10 %
-    /// elongation expectation).
+    /// `give_way_deceleration`); `false` (the default): only once she has slowed to
+    /// half the resume speed and finds her altered course out of water
+    /// ([`Controller`](crate::Controller), `docs/colregs.md` section 4;
+    /// `docs/assumptions.md`: with it fewer Rule 8(d) give-ups, but more of the
+    /// distributed random encounters end aground).
     pub give_way_way_off: bool,
     /// While the route is altered for a crossing in which the tow gives way, the
     /// ship's plan does not gather way (its surge stays at or below the measured

@@ -313,6 +313,10 @@ struct Carried {
     /// Per obstacle slot: the highest heading reached since an encounter began in
     /// which the tow may not turn to port ([`TrackingParams::port_turn_margin`]).
     port_turn_anchor: [Option<f64>; MAX_OBSTACLES],
+    /// The obstacle slot of the crossing for which the tow gives way whose altered course
+    /// ran out of water ([`Controller::short_of_water`]): she keeps the way off until
+    /// that alteration ends.
+    short_of_water: Option<usize>,
     /// The reference course of the last sample ([`TrackingParams::course_rate`]);
     /// `None` before the first sample.
     course: Option<f64>,
@@ -439,6 +443,7 @@ impl Controller {
                 nu_end: [[0.0; 3]; 2],
                 fallbacks: 0,
                 port_turn_anchor: [None; MAX_OBSTACLES],
+                short_of_water: None,
                 course: None,
                 clock: Clock {
                     // sample_time > 0 and finite (checked); at least 1 ns.
@@ -665,13 +670,25 @@ impl Controller {
             t.tracking.lookahead
         };
         let status = t.guidance.colregs.tow_status;
+        let heading_floor = self.heading_floor(m);
+        let reference = self.reference(
+            m,
+            (guidance.active_waypoint, target),
+            altered,
+            lookahead,
+            heading_floor,
+        );
+        let giving_way_to = guidance.governing.filter(|_| giving_way).map(|g| g.index);
+        let short_of_water = self.short_of_water(m, reference[2], giving_way_to);
+        let t = &self.config.tuning;
         // Rule 8(e): giving way in a crossing, the tow takes the way off at a
         // bounded deceleration and keeps it off: the plan's surge stays at or
         // below the measured surge less `give_way_deceleration` T_s, and at or
         // below `give_way_surge` once she has slowed to it. Off the altered leg
         // the tracked point lies abeam or ahead and drew her ahead again before
         // the target was past; a sudden cap at cruise speed made her crab (drift
-        // 37-55 deg) as she slowed and turned.
+        // 37-55 deg) as she slowed and turned. Always with `give_way_way_off`, and
+        // once the altered course has run out of water ([`Controller::short_of_water`]).
         // Rule 17(a)(ii), (b) with 8(e): a stand-on tow that must act and can let the
         // target pass ahead takes the way off the same way, down to `way_off_speed`.
         // Both caps take the way off the same way: the measured surge less the
@@ -681,7 +698,7 @@ impl Controller {
         };
         let rule17 = &t.guidance.colregs.rule17;
         let max_surge = [
-            (giving_way && t.tracking.give_way_way_off)
+            (giving_way && (t.tracking.give_way_way_off || short_of_water))
                 .then(|| cap(t.tracking.give_way_surge, t.tracking.give_way_deceleration)),
             (guidance.way_off && t.scheme.alters())
                 .then(|| cap(rule17.way_off_speed, rule17.way_off_deceleration)),
@@ -689,14 +706,6 @@ impl Controller {
         .into_iter()
         .flatten()
         .reduce(f64::min);
-        let heading_floor = self.heading_floor(m);
-        let reference = self.reference(
-            m,
-            (guidance.active_waypoint, target),
-            altered,
-            lookahead,
-            heading_floor,
-        );
         let situation: [Option<Situation>; MAX_OBSTACLES] =
             std::array::from_fn(|k| self.guidance.situation(k));
         Ok(Guided {
@@ -1135,6 +1144,56 @@ impl Controller {
             floor = Some(floor.map_or(limit, |f: f64| f.max(limit)));
         }
         floor.map(|f| psi + f)
+    }
+
+    /// Whether the tow gives way to the crossing target in slot `giving_way_to` with her
+    /// altered course out of water: she has slackened to half
+    /// [`towing_guidance::GuidanceSettings::resume_speed`] or less, and on the reference
+    /// `course` a vessel of the tow (ship, tugs, from where they are now) comes within
+    /// its bank margin of the waterway ([`ControllerConfig::waterway`]) inside the water
+    /// she needs to take her way off at `give_way_deceleration` from her present surge,
+    /// plus one ship length in hand ([`towing_model::Lane::room_ahead`]). Latched for
+    /// the slot until the alteration for it ends: the tow then keeps the way off (Rule
+    /// 8(e): "slacken her speed or take all way off"), since she can neither hold the
+    /// altered course nor turn back to port while the target is not past and clear
+    /// (Rules 8(d), 15; `docs/colregs.md`, section 4). Held against the bank she
+    /// crabbed and gathered way again before the target was past (random-12-0042). A tow
+    /// still at speed is not braked by this rule: braking with her head held off the
+    /// bank made her crab (drift 31-33 deg, `docs/assumptions.md`). No waterway (or
+    /// scheme III): never.
+    fn short_of_water(
+        &mut self,
+        m: &Measurement,
+        course: f64,
+        giving_way_to: Option<usize>,
+    ) -> bool {
+        let Some(slot) = giving_way_to else {
+            self.carried.short_of_water = None;
+            return false;
+        };
+        if self.carried.short_of_water == Some(slot) {
+            return true;
+        }
+        let Some((lane, margins)) = &self.waterway else {
+            return false;
+        };
+        let u = m.ship[3].max(0.0);
+        if u > 0.5 * self.guidance.params().settings().resume_speed {
+            return false;
+        }
+        let need = u * u / (2.0 * self.config.tuning.tracking.give_way_deceleration)
+            + self.guidance.params().settings().ship_length;
+        let points = [
+            [m.ship[0], m.ship[1]],
+            [m.tugs[0][0], m.tugs[0][1]],
+            [m.tugs[1][0], m.tugs[1][1]],
+        ];
+        let short = points
+            .iter()
+            .zip(margins)
+            .any(|(&p, &margin)| lane.room_ahead(p, course, margin, need) < need);
+        self.carried.short_of_water = if short { Some(slot) } else { None };
+        short
     }
 
     /// The inner loop's parameters.

@@ -829,7 +829,7 @@ pub static PARAMETERS: &[Parameter] = &[
     Parameter {
         name: "tracking.give_way_way_off",
         old_name: None,
-        description: "true: while the route is altered for a crossing in which the tow gives way, she takes the way off (tracking.give_way_deceleration) and keeps it off (tracking.give_way_surge) until the encounter is over (COLREGS Rule 8(e)); false (default): the motion limits only (docs/assumptions.md: more random encounters pass with it, but the paper scenario's distributed scheme I exceeds its 10 % elongation expectation)",
+        description: "true: while the route is altered for a crossing in which the tow gives way, she takes the way off (tracking.give_way_deceleration) and keeps it off (tracking.give_way_surge) until the encounter is over (COLREGS Rule 8(e)); false (default): only once the tow, slowed to half guidance.resume_speed, finds her altered course out of water (docs/colregs.md, section 4; docs/assumptions.md: with it, fewer Rule 8(d) give-ups but more distributed random encounters ending aground)",
         kind: Kind::Boolean {
             get: |t| t.tracking.give_way_way_off,
             set: |t, v| t.tracking.give_way_way_off = v,
@@ -838,7 +838,7 @@ pub static PARAMETERS: &[Parameter] = &[
     Parameter {
         name: "tracking.give_way_surge",
         old_name: None,
-        description: "While the route is altered for a crossing in which the tow gives way, she takes the way off (tracking.give_way_deceleration) down to this surge and keeps it off (COLREGS Rule 8(e)) until the encounter is over; 0.04 m/s, under the 0.05 m/s at which the analyzer counts the way off (docs/assumptions.md)",
+        description: "While the route is altered for a crossing in which the tow gives way and she takes the way off (tracking.give_way_way_off, or her altered course out of water), she slows (tracking.give_way_deceleration) down to this surge and keeps the way off (COLREGS Rule 8(e)) until the encounter is over; 0.04 m/s, under the 0.05 m/s at which the analyzer counts the way off (docs/assumptions.md)",
         kind: Kind::Real {
             unit: "m/s",
             min: Limit::Above(0.0),

@@ -506,6 +506,68 @@ fn giving_way_in_a_crossing_the_plan_does_not_gather_way() {
     }
 }
 
+/// Rule 8(e) with 8(d) and 15: giving way in a crossing (without
+/// `tracking.give_way_way_off`), a tow that has slackened to half her resume speed or
+/// less, whose altered course runs into the bank before she could take her way off and
+/// keep a ship length in hand, keeps the way off while that alteration lasts, even back
+/// in open water and gathering way; the same tow with the water for it, or still at
+/// speed, has no cap. The paper's route in a 2 m half width: the 15 deg altered leg from
+/// the origin meets the bank about 7.7 m on (4.9 m for the ship's centre, with its
+/// hull's margin).
+#[test]
+fn giving_way_with_the_altered_course_out_of_water_keeps_the_way_off() {
+    let (mut scenario, m) = paper_measurement();
+    scenario.waterway.as_mut().unwrap().half_width = 2.0;
+    let config = ControllerConfig::new(scenario);
+    assert!(!config.tuning.tracking.give_way_way_off);
+    let on_altered_leg = |run: f64, surge: f64| {
+        // `run` m from the origin along the altered leg, the tow's formation kept.
+        let course = first_leg_course() + 15f64.to_radians();
+        let (dx, dy) = (run * course.cos(), run * course.sin());
+        let mut m = m;
+        m.ship[0] += dx;
+        m.ship[1] += dy;
+        for tug in &mut m.tugs {
+            tug[0] += dx;
+            tug[1] += dy;
+        }
+        m.ship[3] = surge;
+        m.obstacles[3] = crossing_from_starboard(&m);
+        m
+    };
+    let caps = |c: &mut Controller, m: &Measurement, samples: usize| -> Vec<Option<f64>> {
+        (0..samples)
+            .map(|_| {
+                let r = c.sample(m).unwrap();
+                assert_eq!(r.situation[3], Some(Situation::CrossingGiveWay));
+                assert!(r.guidance.altered);
+                c.last_mpc_input().unwrap().max_surge
+            })
+            .collect()
+    };
+    let none = |v: Vec<Option<f64>>| v.iter().all(Option::is_none);
+    let slow = config.tuning.tracking.give_way_surge;
+    let mut open = Controller::new(config.clone()).unwrap();
+    assert!(none(caps(&mut open, &on_altered_leg(0.0, slow), 30)));
+    let mut at_speed = Controller::new(config.clone()).unwrap();
+    assert!(none(caps(&mut at_speed, &on_altered_leg(4.0, 0.1), 30)));
+
+    let mut near_bank = Controller::new(config.clone()).unwrap();
+    let got = caps(&mut near_bank, &on_altered_leg(4.0, slow), 30);
+    let first = got
+        .iter()
+        .position(Option::is_some)
+        .expect("a cap near the bank");
+    assert!(got[first..].iter().all(|&c| c == Some(slow)), "{got:?}");
+    // Latched for the encounter: back with the water ahead, gathering way, she is
+    // still held to the measured surge less the deceleration.
+    let slowing =
+        config.tuning.tracking.give_way_deceleration * config.tuning.prediction.sample_time;
+    for cap in caps(&mut near_bank, &on_altered_leg(0.0, 0.1), 5) {
+        assert!((cap.expect("latched") - (0.1 - slowing)).abs() < 1e-12);
+    }
+}
+
 /// Rule 17(a)(ii), (b) with 8(e): a give-way target from port on a collision course,
 /// 9 m off on the port side (beyond d_D) and 54 s from the CPA: the stand-on tow keeps
 /// the route and takes the way off, the plan's surge capped at the measured surge less

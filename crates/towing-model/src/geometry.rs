@@ -427,6 +427,33 @@ impl Lane {
         };
         (q.distance, grad)
     }
+
+    /// The water ahead of `p` on `course`: the run `s` in `[0, reach]` after which going
+    /// on along the course brings `p + s (cos course, sin course)` within `margin` of
+    /// the bank ([`Lane::excess`] at least `-margin`) and nearer to it, or `reach` if
+    /// it does not within the reach (m). A point within the margin already has no room
+    /// if the course takes it nearer the bank, and all the room it needs if the course
+    /// takes it away (a tug astern of the route's start). Marched in steps of
+    /// [`Lane::ROOM_STEP`], so a bank is found to within that step.
+    #[must_use]
+    pub fn room_ahead(&self, p: Point, course: f64, margin: f64, reach: f64) -> f64 {
+        let (sin, cos) = course.sin_cos();
+        let at = |s: f64| self.excess([p[0] + s * cos, p[1] + s * sin]);
+        let steps = (reach.max(0.0) / Self::ROOM_STEP).ceil() as usize;
+        let mut before = (0.0, at(0.0));
+        for k in 1..=steps {
+            let s = (k as f64 * Self::ROOM_STEP).min(reach);
+            let e = at(s);
+            if e >= -margin && e > before.1 {
+                return before.0;
+            }
+            before = (s, e);
+        }
+        reach
+    }
+
+    /// The step of [`Lane::room_ahead`], m.
+    pub const ROOM_STEP: f64 = 0.05;
 }
 
 #[cfg(test)]
@@ -581,6 +608,26 @@ mod tests {
         assert!((lane.hull_excess(&hull, 5.0, -2.3, 0.0) - 0.8).abs() < 1e-12);
         // Turned across the lane, the bow reaches further.
         assert!(lane.hull_excess(&hull, 5.0, -1.2, -PI / 2.0) > 0.0);
+    }
+
+    #[test]
+    fn room_ahead_is_the_run_to_the_bank_less_the_margin() {
+        let lane = l_lane();
+        // On the first leg (North), 0.5 m to starboard, heading East (course 90 deg):
+        // the bank is 1.5 m away, 1.0 m with a 0.5 m margin.
+        let east = PI / 2.0;
+        let room = lane.room_ahead([5.0, 0.5], east, 0.5, 3.0);
+        assert!((room - 1.0).abs() <= Lane::ROOM_STEP + 1e-12, "{room}");
+        // 30 deg off the leg, the run to the same bank doubles.
+        let room = lane.room_ahead([5.0, 0.5], PI / 6.0, 0.5, 3.0);
+        assert!((room - 2.0).abs() <= Lane::ROOM_STEP + 1e-12, "{room}");
+        // Along the leg, no bank within the reach.
+        assert_eq!(lane.room_ahead([5.0, 0.5], 0.0, 0.5, 3.0), 3.0);
+        // Already within the margin: no room going nearer the bank, all of it going away.
+        assert_eq!(lane.room_ahead([5.0, 1.8], east, 0.5, 3.0), 0.0);
+        assert_eq!(lane.room_ahead([5.0, 1.8], -east, 0.5, 3.0), 3.0);
+        // Astern of the route's start, heading along it: away from the end cap.
+        assert_eq!(lane.room_ahead([-2.5, 0.0], 0.0, 0.5, 3.0), 3.0);
     }
 
     #[test]

@@ -31,7 +31,15 @@
 //! Warm start: [`Admm::shift`] moves every plan and multiplier one sample ahead
 //! (the last sample repeated) for the next control sample. Without a shift since
 //! the construction (or [`Admm::reset`]) the sample starts cold: the plans repeat
-//! the previously applied command, the multipliers are zero.
+//! the previously applied command, the multipliers are zero. A sample that ends at
+//! `max_iterations` without consensus leaves the multipliers as it found them: when
+//! the subproblems cannot agree, the multiplier updates (27) grow without bound (the
+//! dual iterates of ADMM diverge on an infeasible consensus, Boyd et al. 2010,
+//! section 3.3), and carried into the next sample they drove the tugs' plans away
+//! from the formation (multiplier norm 1-5 when converging, 200-1000 after a capped
+//! sample; random-12-0032 and -0074, distributed: tug speeds 5 times cruise, tug-tug
+//! overlaps and groundings, gone with this rule, `docs/assumptions.md`). A sample
+//! ended by the time budget keeps its multipliers: the next sample goes on from them.
 //!
 //! Allocation: none per sample; the subproblems, multipliers, residual history
 //! (fixed capacity [`MAX_ITERATIONS`]) are made at construction.
@@ -499,7 +507,8 @@ impl Admm {
                 .set_inputs([input.previous.tugs[1]; HORIZON]);
             self.lambda = [[[0.0; 3]; HORIZON]; 2];
         }
-        Core {
+        let saved = self.lambda;
+        let report = Core {
             settings: self.settings,
             ship: &mut self.ship,
             tug1: &mut self.tug1,
@@ -508,7 +517,13 @@ impl Admm {
             lambda: &mut self.lambda,
             f_prev: &mut self.f_prev,
         }
-        .run(input, budget)
+        .run(input, budget);
+        // A sample that the iteration cap ends without consensus leaves the multipliers
+        // as it found them (module docs, "Warm start").
+        if !report.converged && !report.budget_hit {
+            self.lambda = saved;
+        }
+        report
     }
 }
 

@@ -418,6 +418,38 @@ fn warm_start_needs_fewer_iterations() {
     assert_eq!(again.iterations, cold_next.iterations);
 }
 
+/// A sample that the iteration cap ends without consensus leaves the multipliers as it
+/// found them (the warm start of the last converged sample); a converged sample moves
+/// them.
+#[test]
+fn a_capped_sample_leaves_the_multipliers_as_it_found_them() {
+    let input = displaced_input();
+    let mut a = admm(AdmmSettings::default());
+    let first = a.solve_sample(&input);
+    assert!(first.converged);
+    let next = plant_like_next(&a, &input, &first);
+    a.shift();
+    let warm = a.snapshot();
+    assert!(warm.lambda.iter().flatten().flatten().any(|l| *l != 0.0));
+
+    let mut capped = admm(AdmmSettings {
+        max_iterations: 1,
+        ..AdmmSettings::default()
+    });
+    capped.restore(&warm).unwrap();
+    // The displaced tugs far off: one iteration cannot reach consensus.
+    let mut far = next;
+    far.tugs[0][1] += 1.0;
+    let r = capped.solve_sample(&far);
+    assert!(!r.converged && !r.budget_hit);
+    assert_eq!(capped.lambda(), &warm.lambda);
+
+    let mut b = admm(AdmmSettings::default());
+    b.restore(&warm).unwrap();
+    assert!(b.solve_sample(&next).converged);
+    assert_ne!(b.lambda(), &warm.lambda);
+}
+
 /// A subproblem that cannot be solved is a value in the report.
 #[test]
 fn failed_subproblems_are_reported() {
