@@ -71,8 +71,8 @@ use crate::error::Result;
 
 use crate::colregs::{classify, Situation};
 use crate::geometry::{
-    abaft_and_opening, course_velocity, cpa_tcpa, crossed_ahead, dist, drawing_away, hull_ellipse_clearance,
-    line_coordinates, relative_bearing, wrap, RouteCourse,
+    abaft_and_opening, course_velocity, cpa_tcpa, crossed_ahead, dist, drawing_away,
+    hull_ellipse_clearance, line_coordinates, relative_bearing, wrap, RouteCourse,
 };
 use crate::rows::VESSELS;
 use crate::step::{Obstacle, ObstacleKind, PlantStep, RunGeometry, Vessel};

@@ -108,6 +108,15 @@ impl Measurement {
         m
     }
 
+    /// The positions `[x, y]` of the ship, tug 1 and tug 2.
+    fn positions(&self) -> [[f64; 2]; 3] {
+        [
+            [self.ship[0], self.ship[1]],
+            [self.tugs[0][0], self.tugs[0][1]],
+            [self.tugs[1][0], self.tugs[1][1]],
+        ]
+    }
+
     fn tow_state(&self) -> TowState {
         let pose = |s: &[f64; 6]| Pose::new(s[0], s[1], s[2]);
         TowState {
@@ -1177,18 +1186,15 @@ impl Controller {
         let Some((lane, margins)) = &self.waterway else {
             return false;
         };
+        let settings = self.guidance.params().settings();
         let u = m.ship[3].max(0.0);
-        if u > 0.5 * self.guidance.params().settings().resume_speed {
+        if u > 0.5 * settings.resume_speed {
             return false;
         }
         let need = u * u / (2.0 * self.config.tuning.tracking.give_way_deceleration)
-            + self.guidance.params().settings().ship_length;
-        let points = [
-            [m.ship[0], m.ship[1]],
-            [m.tugs[0][0], m.tugs[0][1]],
-            [m.tugs[1][0], m.tugs[1][1]],
-        ];
-        let short = points
+            + settings.ship_length;
+        let short = m
+            .positions()
             .iter()
             .zip(margins)
             .any(|(&p, &margin)| lane.room_ahead(p, course, margin, need) < need);
@@ -1269,11 +1275,7 @@ impl Controller {
             .clearance
             .max_obstacles
             .min(t.tug.clearance.max_obstacles);
-        let points = [
-            [m.ship[0], m.ship[1]],
-            [m.tugs[0][0], m.tugs[0][1]],
-            [m.tugs[1][0], m.tugs[1][1]],
-        ];
+        let points = m.positions();
         let ts = self.config.tuning.prediction.sample_time;
         let mut candidates: [(f64, usize); MAX_OBSTACLES] = [(f64::INFINITY, 0); MAX_OBSTACLES];
         let mut n = 0;
