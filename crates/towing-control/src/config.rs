@@ -188,11 +188,10 @@ pub struct TrackingParams {
     /// 8(e), Rule 16) so the target crosses ahead and the tow passes astern.
     pub give_way_lookahead: f64,
     /// The tow keeps the way off while giving way in a crossing (`give_way_surge`,
-    /// `give_way_deceleration`); `false` (the default): only once she has slowed to
-    /// half the resume speed and finds her altered course out of water
-    /// ([`Controller`](crate::Controller), `docs/colregs.md` section 4;
-    /// `docs/assumptions.md`: with it fewer Rule 8(d) give-ups, but more of the
-    /// distributed random encounters end aground).
+    /// `give_way_deceleration`; `true`, the default, COLREGS Rule 8(e)); `false`: only
+    /// once she has slowed to half the resume speed and finds her altered course out of
+    /// water ([`Controller`](crate::Controller), `docs/colregs.md` section 4;
+    /// `docs/assumptions.md`: without it, more Rule 8(d) give-ups).
     pub give_way_way_off: bool,
     /// While the route is altered for a crossing in which the tow gives way, the
     /// ship's plan does not gather way (its surge stays at or below the measured
@@ -238,7 +237,7 @@ impl Default for TrackingParams {
         TrackingParams {
             lookahead: 3.5,
             give_way_lookahead: 0.0,
-            give_way_way_off: false,
+            give_way_way_off: true,
             give_way_surge: 0.04,
             give_way_deceleration: 0.005,
             los_distance: 2.5,

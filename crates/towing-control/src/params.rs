@@ -829,7 +829,7 @@ pub static PARAMETERS: &[Parameter] = &[
     Parameter {
         name: "tracking.give_way_way_off",
         old_name: None,
-        description: "true: while the route is altered for a crossing in which the tow gives way, she takes the way off (tracking.give_way_deceleration) and keeps it off (tracking.give_way_surge) until the encounter is over (COLREGS Rule 8(e)); false (default): only once the tow, slowed to half guidance.resume_speed, finds her altered course out of water (docs/colregs.md, section 4; docs/assumptions.md: with it, fewer Rule 8(d) give-ups but more distributed random encounters ending aground)",
+        description: "true (default): while the route is altered for a crossing in which the tow gives way, she takes the way off (tracking.give_way_deceleration) and keeps it off (tracking.give_way_surge) until the encounter is over (COLREGS Rule 8(e)); false: only once the tow, slowed to half guidance.resume_speed, finds her altered course out of water (docs/colregs.md, section 4; docs/assumptions.md: without it, more Rule 8(d) give-ups)",
         kind: Kind::Boolean {
             get: |t| t.tracking.give_way_way_off,
             set: |t, v| t.tracking.give_way_way_off = v,
@@ -862,7 +862,7 @@ pub static PARAMETERS: &[Parameter] = &[
     Parameter {
         name: "guidance.rule17_tcpa",
         old_name: None,
-        description: "Rule 17(a)(ii): a stand-on tow acts once the TCPA of a target still closing to under guidance.rule17_dcpa is at most this, wherever the target is (not only within the detection distance); 55 s, 5 s inside the analyzer's 60 s (docs/assumptions.md)",
+        description: "Rule 17(a)(ii): a stand-on tow acts once the TCPA of a target still closing to under guidance.rule17_dcpa is at most this, wherever the target is (not only within the detection distance); a give-way tow acts by the same test at the latest (docs/colregs.md, Acting by the CPA); 55 s, 5 s inside the analyzer's 60 s (docs/assumptions.md)",
         kind: Kind::Real {
             unit: "s",
             min: Limit::Above(0.0),

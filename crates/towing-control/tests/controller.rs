@@ -463,25 +463,23 @@ fn crossing_from_starboard(m: &Measurement) -> ObstacleSlot {
 /// Rule 8(e): giving way in a crossing, the tow takes the way off at a bounded
 /// deceleration and keeps it off: the plan's surge is capped at the measured surge less
 /// `tracking.give_way_deceleration` T_s, and at `tracking.give_way_surge` once she is
-/// slower. Without the encounter, or without `tracking.give_way_way_off` (the default),
-/// there is no cap.
+/// slower. Without the encounter, or with `tracking.give_way_way_off` (on by default)
+/// switched off, there is no cap.
 #[test]
 fn giving_way_in_a_crossing_the_plan_does_not_gather_way() {
     let (scenario, mut m) = paper_measurement();
     let target = crossing_from_starboard(&m);
-    let mut config = ControllerConfig::new(scenario.clone());
-    let mut off = Controller::new(config.clone()).unwrap();
+    let config = ControllerConfig::new(scenario.clone());
+    assert!(config.tuning.tracking.give_way_way_off, "on by default");
+    let mut switched_off = config.clone();
+    switched_off.tuning.tracking.give_way_way_off = false;
+    let mut off = Controller::new(switched_off).unwrap();
     let original = m.obstacles[3];
     m.obstacles[3] = target;
     let r = off.sample(&m).unwrap();
     assert_eq!(r.situation[3], Some(Situation::CrossingGiveWay));
-    assert_eq!(
-        off.last_mpc_input().unwrap().max_surge,
-        None,
-        "off by default"
-    );
+    assert_eq!(off.last_mpc_input().unwrap().max_surge, None);
     m.obstacles[3] = original;
-    config.tuning.tracking.give_way_way_off = true;
     let cap = config.tuning.tracking.give_way_surge;
     let slowing =
         config.tuning.tracking.give_way_deceleration * config.tuning.prediction.sample_time;
@@ -506,8 +504,8 @@ fn giving_way_in_a_crossing_the_plan_does_not_gather_way() {
     }
 }
 
-/// Rule 8(e) with 8(d) and 15: giving way in a crossing (without
-/// `tracking.give_way_way_off`), a tow that has slackened to half her resume speed or
+/// Rule 8(e) with 8(d) and 15: giving way in a crossing (with
+/// `tracking.give_way_way_off` switched off), a tow that has slackened to half her resume speed or
 /// less, whose altered course runs into the bank before she could take her way off and
 /// keep a ship length in hand, keeps the way off while that alteration lasts, even back
 /// in open water and gathering way; the same tow with the water for it, or still at
@@ -518,8 +516,8 @@ fn giving_way_in_a_crossing_the_plan_does_not_gather_way() {
 fn giving_way_with_the_altered_course_out_of_water_keeps_the_way_off() {
     let (mut scenario, m) = paper_measurement();
     scenario.waterway.as_mut().unwrap().half_width = 2.0;
-    let config = ControllerConfig::new(scenario);
-    assert!(!config.tuning.tracking.give_way_way_off);
+    let mut config = ControllerConfig::new(scenario);
+    config.tuning.tracking.give_way_way_off = false;
     let on_altered_leg = |run: f64, surge: f64| {
         // `run` m from the origin along the altered leg, the tow's formation kept.
         let course = first_leg_course() + 15f64.to_radians();

@@ -18,7 +18,11 @@
 //!    than the route does ([`StaticHazardPolicy::WhenAlteringHelps`], the default;
 //!    [`StaticHazardPolicy::ByDistance`] drops that test), a target ship if its
 //!    action is
-//!    [`Action::AlterToStarboard`] or [`Action::KeepOut`]. A stand-on tow keeps the
+//!    [`Action::AlterToStarboard`] or [`Action::KeepOut`]; such a target also demands
+//!    it beyond its detection distance once the CPA test of Rule 17 holds
+//!    ([`crate::Rule17Settings::give_way_failed`]): the give-way tow acts no later than
+//!    her failure to act would let the stand-on vessel act (Rules 16, 17(a)(ii);
+//!    `docs/colregs.md`, "Acting by the CPA"). A stand-on tow keeps the
 //!    route until Rule 17 allows action ([`Action::StandOnThenAct`],
 //!    [`crate::Rule17Settings`]), judged by the CPA wherever the target is; it then
 //!    takes the way off ([`Manoeuvre::TakeWayOff`], route kept) if the slowed tow lets
@@ -139,7 +143,9 @@ pub struct ObstacleAssessment {
     /// The policy: for a target ship [`crate::action`] of `situation`; for a
     /// static hazard [`Action::AlterToStarboard`] (the paper's by-distance rule).
     pub action: Action,
-    /// Within its detection distance (`d_D`, or the static hazards' distance).
+    /// Within its detection distance (`d_D`, or the static hazards' distance), or a
+    /// target the tow gives way to whose CPA meets Rule 17's test (closing, TCPA and
+    /// DCPA within [`crate::Rule17Settings`]).
     pub detected: bool,
     /// Whether a starboard alteration may be asked for: for a static hazard under
     /// [`StaticHazardPolicy::WhenAlteringHelps`], true when the altered leg passes
@@ -277,7 +283,14 @@ pub fn assess_obstacle(
             )
         }
     };
-    let detected = range <= detection;
+    // Rule 16 with 17(a)(ii): a tow that must keep out of the way acts no later than
+    // the moment her failure to act would let the stand-on vessel act, judged by the
+    // same CPA test (`Rule17Settings::give_way_failed`), even before the target is
+    // within d_D: a fast crossing target reached d_D with too little time left for the
+    // tow to let it pass clear ahead of her forward tug (`docs/colregs.md`, section 4).
+    let gives_way_late = matches!(policy, Action::AlterToStarboard | Action::KeepOut)
+        && encounter.is_some_and(|enc| s.colregs.rule17.give_way_failed(&enc.cpa));
+    let detected = range <= detection || gives_way_late;
     let alteration_allowed = match (obstacle, s.static_hazard_policy, context.leg) {
         (
             ActiveObstacle::Circle { centre, .. },
@@ -848,7 +861,7 @@ impl ReferenceSystem {
             ObstacleKind::StaticCircle => s.static_detection_distance,
             _ => s.detection_distance,
         };
-        let near = a.range <= detection + s.release_margin;
+        let near = a.range <= detection + s.release_margin || a.detected;
         let slowed = context.way_off;
         if a.past_and_clear {
             next.past |= bit;
@@ -1153,13 +1166,58 @@ mod tests {
         assert!((out.eta_sd.psi - deg(15.0)).abs() < 1e-12);
         assert_eq!(out.route_waypoint, Pose::new(30.0, 0.0, 0.0));
 
-        // The same target beyond d_D: not altered.
+        // The same target beyond d_D, its CPA more than 55 s away (Rule 17's TCPA):
+        // not altered.
         let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
-        let far = vessel(2.0 + TUG2_AHEAD + 7.2, 0.2, PI, 0.07);
+        let far = vessel(2.0 + TUG2_AHEAD + 7.2, 0.2, PI, 0.05);
         let out = rs.update(&tow, &[far]).unwrap();
+        assert!(out.governing.unwrap().encounter.unwrap().cpa.tcpa > 55.0);
         assert!(!out.altered);
         assert_eq!(out.eta_sd, Pose::new(30.0, 0.0, 0.0));
         assert_eq!(out.governing.unwrap().manoeuvre, Manoeuvre::FollowRoute);
+    }
+
+    /// Rule 16 with 17(a)(ii): a give-way tow acts no later than her failure to act
+    /// would let the stand-on vessel act (closing, TCPA <= 55 s, DCPA < 2.5 m), even
+    /// with the target still beyond d_D; the encounter is then held as one detected
+    /// within it. A target she stands on at the same CPA is Rule 17's business, and one
+    /// passing wide is no risk.
+    #[test]
+    fn a_give_way_tow_acts_by_the_cpa_when_the_target_closes_fast() {
+        let tow = tow_at(Pose::new(2.0, 0.0, 0.0), 0.1);
+        let ship = tow.ship.position();
+        // A crossing target from starboard at 0.25 m/s, 10 m from the point 4 m ahead,
+        // where the ship will be 40 s on: TCPA 40 s, DCPA about 0.
+        let aim = [ship[0] + 4.0, ship[1]];
+        let from = [
+            aim[0] + 10.0 * deg(70.0).cos(),
+            aim[1] + 10.0 * deg(70.0).sin(),
+        ];
+        let course = (aim[1] - from[1]).atan2(aim[0] - from[0]);
+        let fast = vessel(from[0], from[1], course, 0.25);
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let out = rs.update(&tow, &[fast]).unwrap();
+        let g = out.governing.unwrap();
+        assert!(g.range > 7.5, "beyond d_D + release margin: {}", g.range);
+        let enc = g.encounter.unwrap();
+        assert_eq!(enc.situation, Situation::CrossingGiveWay);
+        assert!(enc.cpa.tcpa < 55.0 && enc.cpa.dcpa < 2.5, "{:?}", enc.cpa);
+        assert!(g.detected && out.altered);
+        assert_eq!(g.manoeuvre, Manoeuvre::AlterToStarboard);
+        assert_eq!(rs.situation(0), Some(Situation::CrossingGiveWay));
+        // The next sample, the target a little nearer: still in the encounter.
+        let out = rs.update(&tow, &[moved(fast, 0.1)]).unwrap();
+        assert!(out.altered);
+
+        // The same target 5 m farther ahead, passing wide (DCPA about 3.9 m): no
+        // action beyond d_D.
+        let wide = vessel(from[0] + 5.0, from[1], course, 0.25);
+        let mut rs = ReferenceSystem::new(north_route(), GuidanceParams::default());
+        let out = rs.update(&tow, &[wide]).unwrap();
+        let g = out.governing.unwrap();
+        assert!(g.encounter.unwrap().cpa.dcpa > 2.5);
+        assert!(!g.detected && !out.altered);
+        assert_eq!(rs.situation(0), Some(Situation::Safe));
     }
 
     #[test]
