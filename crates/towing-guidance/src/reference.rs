@@ -248,46 +248,14 @@ pub fn assess_obstacle(
         (TowVessel::Tug1, tow.tug1.position(), s.tug_length),
         (TowVessel::Tug2, tow.tug2.position(), s.tug_length),
     ];
-    let mut nearest = vessels[0];
-    let mut range = obstacle.range(nearest.1);
-    for v in &vessels[1..] {
-        let r = obstacle.range(v.1);
-        if r < range {
-            range = r;
-            nearest = *v;
-        }
-    }
-    let (encounter, situation, policy, detection) = match obstacle {
-        ActiveObstacle::Circle { .. } => (
-            None,
-            None,
-            Action::AlterToStarboard,
-            s.static_detection_distance,
-        ),
-        ActiveObstacle::Vessel(target) => {
-            let enc = classify(
-                tow.ship,
-                tow.ship_vel_n,
-                target,
-                &s.colregs.thresholds,
-                s.colregs.risk_dcpa,
-            );
-            let situation = context
-                .held
-                .unwrap_or_else(|| safe_reading(&enc, &s.colregs.thresholds));
-            (
-                Some(enc),
-                Some(situation),
-                action(situation, s.colregs.tow_status),
-                s.detection_distance,
-            )
-        }
-    };
+    let (nearest, range) = nearest_vessel(obstacle, &vessels);
+    let (encounter, situation, policy, detection) = reading(params, tow, obstacle, context.held);
     // Rule 16 with 17(a)(ii): a tow that must keep out of the way acts no later than
     // the moment her failure to act would let the stand-on vessel act, judged by the
     // same CPA test (`Rule17Settings::give_way_failed`), even before the target is
     // within d_D: a fast crossing target reached d_D with too little time left for the
-    // tow to let it pass clear ahead of her forward tug (`docs/colregs.md`, section 4).
+    // tow to let it pass clear ahead of her forward tug (`docs/colregs.md`, section 2,
+    // "Acting by the CPA").
     let gives_way_late = matches!(policy, Action::AlterToStarboard | Action::KeepOut)
         && encounter.is_some_and(|enc| s.colregs.rule17.give_way_failed(&enc.cpa));
     let detected = range <= detection || gives_way_late;
@@ -370,6 +338,61 @@ pub fn assess_obstacle(
         resume_clear,
         passes_clear,
         drawing_away,
+    }
+}
+
+/// The vessel of the tow (kind, position, length) nearest to `obstacle` by its
+/// range-equivalent distance (eq. (8): `min{d_Sj, d_1j, d_2j}`), and that range (m).
+fn nearest_vessel(
+    obstacle: &ActiveObstacle,
+    vessels: &[(TowVessel, [f64; 2], f64); 3],
+) -> ((TowVessel, [f64; 2], f64), f64) {
+    let mut nearest = vessels[0];
+    let mut range = obstacle.range(nearest.1);
+    for v in &vessels[1..] {
+        let r = obstacle.range(v.1);
+        if r < range {
+            range = r;
+            nearest = *v;
+        }
+    }
+    (nearest, range)
+}
+
+/// The COLREGS reading of `obstacle`: for a target ship its encounter, the situation
+/// the policy is taken from (`held`, else the safe reading of the present one), that
+/// policy and `d_D`; for a static hazard no encounter, the paper's by-distance
+/// alteration and the static detection distance.
+fn reading(
+    params: &GuidanceParams,
+    tow: &TowState,
+    obstacle: &ActiveObstacle,
+    held: Option<Situation>,
+) -> (Option<Encounter>, Option<Situation>, Action, f64) {
+    let s = params.settings();
+    match obstacle {
+        ActiveObstacle::Circle { .. } => (
+            None,
+            None,
+            Action::AlterToStarboard,
+            s.static_detection_distance,
+        ),
+        ActiveObstacle::Vessel(target) => {
+            let enc = classify(
+                tow.ship,
+                tow.ship_vel_n,
+                target,
+                &s.colregs.thresholds,
+                s.colregs.risk_dcpa,
+            );
+            let situation = held.unwrap_or_else(|| safe_reading(&enc, &s.colregs.thresholds));
+            (
+                Some(enc),
+                Some(situation),
+                action(situation, s.colregs.tow_status),
+                s.detection_distance,
+            )
+        }
     }
 }
 
