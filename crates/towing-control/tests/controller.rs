@@ -505,8 +505,8 @@ fn giving_way_in_a_crossing_the_plan_does_not_gather_way() {
 }
 
 /// Rule 8(e) with 8(d) and 15: giving way in a crossing (with
-/// `tracking.give_way_way_off` switched off), a tow that has slackened to half her resume speed or
-/// less, whose altered course runs into the bank before she could take her way off and
+/// `tracking.give_way_way_off` switched off), a tow that has slackened to half her
+/// resume speed or less, whose altered course runs into the bank before she could take her way off and
 /// keep a ship length in hand, keeps the way off while that alteration lasts, even back
 /// in open water and gathering way; the same tow with the water for it, or still at
 /// speed, has no cap. The paper's route in a 2 m half width: the 15 deg altered leg from

@@ -4,6 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use towing_model::ObstacleKind;
+
 use crate::colregs::ColregsSettings;
 use crate::error::ParamError;
 
@@ -119,6 +121,18 @@ pub struct GuidanceSettings {
     pub tug_length: f64,
     /// COLREGS classifier, tow status and Rule 17 thresholds.
     pub colregs: ColregsSettings,
+}
+
+impl GuidanceSettings {
+    /// The detection distance for an obstacle of `kind`: `static_detection_distance`
+    /// for a static hazard, `d_D` (`detection_distance`) for a target ship.
+    #[must_use]
+    pub fn detection_distance_for(&self, kind: ObstacleKind) -> f64 {
+        match kind {
+            ObstacleKind::StaticCircle => self.static_detection_distance,
+            _ => self.detection_distance,
+        }
+    }
 }
 
 impl Default for GuidanceSettings {

@@ -249,7 +249,8 @@ pub fn assess_obstacle(
         (TowVessel::Tug2, tow.tug2.position(), s.tug_length),
     ];
     let (nearest, range) = nearest_vessel(obstacle, &vessels);
-    let (encounter, situation, policy, detection) = reading(params, tow, obstacle, context.held);
+    let (encounter, situation, policy) = reading(params, tow, obstacle, context.held);
+    let detection = s.detection_distance_for(obstacle.kind());
     // Rule 16 with 17(a)(ii): a tow that must keep out of the way acts no later than
     // the moment her failure to act would let the stand-on vessel act, judged by the
     // same CPA test (`Rule17Settings::give_way_failed`), even before the target is
@@ -360,23 +361,17 @@ fn nearest_vessel(
 }
 
 /// The COLREGS reading of `obstacle`: for a target ship its encounter, the situation
-/// the policy is taken from (`held`, else the safe reading of the present one), that
-/// policy and `d_D`; for a static hazard no encounter, the paper's by-distance
-/// alteration and the static detection distance.
+/// the policy is taken from (`held`, else the safe reading of the present one) and that
+/// policy; for a static hazard no encounter and the paper's by-distance alteration.
 fn reading(
     params: &GuidanceParams,
     tow: &TowState,
     obstacle: &ActiveObstacle,
     held: Option<Situation>,
-) -> (Option<Encounter>, Option<Situation>, Action, f64) {
+) -> (Option<Encounter>, Option<Situation>, Action) {
     let s = params.settings();
     match obstacle {
-        ActiveObstacle::Circle { .. } => (
-            None,
-            None,
-            Action::AlterToStarboard,
-            s.static_detection_distance,
-        ),
+        ActiveObstacle::Circle { .. } => (None, None, Action::AlterToStarboard),
         ActiveObstacle::Vessel(target) => {
             let enc = classify(
                 tow.ship,
@@ -390,7 +385,6 @@ fn reading(
                 Some(enc),
                 Some(situation),
                 action(situation, s.colregs.tow_status),
-                s.detection_distance,
             )
         }
     }
@@ -880,11 +874,7 @@ impl ReferenceSystem {
     ) -> bool {
         let s = self.params.settings();
         let bit = 1u64 << a.index;
-        let detection = match a.kind {
-            ObstacleKind::StaticCircle => s.static_detection_distance,
-            _ => s.detection_distance,
-        };
-        let near = a.range <= detection + s.release_margin || a.detected;
+        let near = a.range <= s.detection_distance_for(a.kind) + s.release_margin || a.detected;
         let slowed = context.way_off;
         if a.past_and_clear {
             next.past |= bit;
@@ -1203,8 +1193,7 @@ mod tests {
     /// Rule 16 with 17(a)(ii): a give-way tow acts no later than her failure to act
     /// would let the stand-on vessel act (closing, TCPA <= 55 s, DCPA < 2.5 m), even
     /// with the target still beyond d_D; the encounter is then held as one detected
-    /// within it. A target she stands on at the same CPA is Rule 17's business, and one
-    /// passing wide is no risk.
+    /// within it. A target passing wide is no risk and gets no action beyond d_D.
     #[test]
     fn a_give_way_tow_acts_by_the_cpa_when_the_target_closes_fast() {
         let tow = tow_at(Pose::new(2.0, 0.0, 0.0), 0.1);
