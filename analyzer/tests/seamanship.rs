@@ -2,6 +2,7 @@
 //! route North from (0, 0) to (50, 0), the ship at 0.065 m/s with the tugs 2 m ahead and
 //! behind on its heading, plant steps of 0.5 s, scripted departures from that.
 
+use analyzer::colregs::Situation;
 use analyzer::metric::astern::{self, AsternReport, AsternTracker};
 use analyzer::metric::drift::{self, DriftReport, DriftTracker};
 use analyzer::metric::progress::{self, ProgressReport, ProgressTracker};
@@ -9,7 +10,9 @@ use analyzer::metric::rules::{self, RulesReport, RulesTracker};
 use analyzer::metric::speed::{self, SpeedReport, SpeedTracker};
 use analyzer::metric::waterway::{self, WaterwayReport, WaterwayTracker};
 use analyzer::metric::{Metric, StepFacts};
-use analyzer::step::{Obstacle, ObstacleKind, PlantStep, RunGeometry, Vessel};
+use analyzer::step::{
+    ControlEncounter, ControlSample, Obstacle, ObstacleKind, PlantStep, RunGeometry, Vessel,
+};
 use analyzer::thresholds::Thresholds;
 use analyzer::verdict::Reason;
 
@@ -128,6 +131,17 @@ fn run(
     offset: impl Fn(f64) -> [f64; 2],
     targets: &[Target],
 ) -> SeamanshipReport {
+    run_controlled(t_end, motion, offset, targets, |_| None)
+}
+
+/// [`run`] with the controller's sample at each step given by `control(t)`.
+fn run_controlled(
+    t_end: f64,
+    motion: impl Fn(f64, [f64; 2]) -> (f64, f64, f64),
+    offset: impl Fn(f64) -> [f64; 2],
+    targets: &[Target],
+    control: impl Fn(f64) -> Option<ControlSample>,
+) -> SeamanshipReport {
     let g = geometry();
     let mut seamanship = Seamanship::new(&g, &Thresholds::default());
     let mut pos = [0.0, 0.0];
@@ -165,11 +179,12 @@ fn run(
             .enumerate()
             .map(|(i, tg)| tg.at(i as u32 + 1, t))
             .collect();
+        let sample = control(t);
         seamanship.push(&PlantStep {
             t,
             vessels: [ship, tug(-2.0), tug(2.0)],
             obstacles: &obstacles,
-            control: None,
+            control: sample.as_ref(),
         });
     }
     seamanship.finish()
@@ -906,6 +921,79 @@ fn seamanship_a_stand_on_departure_made_while_acting_for_another_target_is_excus
     let t = broken(&r).expect("broken");
     assert!((470.0..=471.0).contains(&t), "{t}");
     assert!(metrics(&verdict(&r)).contains(&"rule17_stand_on"));
+}
+
+#[test]
+fn seamanship_a_give_way_action_taken_by_the_cpa_before_detection_excuses_the_stand_on() {
+    // Regression (random-12-0009, centralized): the guidance gives way by Rule 17's CPA
+    // test as well as by d_D, and took her way off for a fast crossing target from
+    // starboard 30 s before any vessel of the tow was within 7 m of it; the instrument
+    // opened that give-way duty only at detection and held the slowing against her
+    // stand-on duty to a slow target from port. Here the starboard target (0.25 m/s) is
+    // on a collision course with the tow (both at x = 24 m at 369.2 s, TCPA 60 s at
+    // 309.2 s, range from the forward tug then 15 m); she stops at 310 s and resumes at
+    // 380 s, after it crossed ahead. The port target (eastward at 0.01 m/s along
+    // x = 25 m) is detected at about 282 s, with a TCPA over 60 s until after 380 s.
+    let t_cross = 24.0 / CRUISE;
+    let give_way = || Target {
+        name: "starboard",
+        at_t0: [24.0, 0.25 * t_cross],
+        course_deg: 270.0,
+        speed: 0.25,
+    };
+    let stand_on = || Target {
+        name: "port",
+        at_t0: [25.0, -8.0],
+        course_deg: 90.0,
+        speed: 0.01,
+    };
+    let stop = |t: f64, p: [f64; 2]| {
+        if t > 310.0 && t <= 380.0 {
+            (0.0, 0.0, 0.0)
+        } else {
+            cruise(t, p)
+        }
+    };
+    // The controller reads the starboard target (slot 1) as crossing give-way from 310 s.
+    let controller = |t: f64| {
+        Some(ControlSample {
+            t,
+            altered: false,
+            active_waypoint: 1,
+            encounters: vec![ControlEncounter {
+                slot: 1,
+                situation: (t >= 310.0).then_some(Situation::CrossingGiveWay),
+                role_code: if t >= 310.0 { 1 } else { 0 },
+            }],
+        })
+    };
+    let port = |r: &SeamanshipReport| {
+        let port = r.rules.targets.iter().find(|t| t.target == "port");
+        port.expect("port").clone()
+    };
+    // Judged from detection only (no controller log): the stop breaks the stand-on.
+    let r = run(700.0, stop, no_offset, &[give_way(), stand_on()]);
+    let starboard = &r.rules.targets[0];
+    let t_detect = starboard.t_detect_s.expect("detected");
+    assert!((335.0..350.0).contains(&t_detect), "{starboard:?}");
+    let p = port(&r);
+    let t = p.t_stand_on_broken_s.unwrap_or_else(|| panic!("{p:?}"));
+    assert!((310.0..=311.0).contains(&t), "{t}");
+    assert!(metrics(&verdict(&r)).contains(&"rule17_stand_on"));
+    // The controller gave way by the CPA: the stop is that action, excused from 310 s.
+    let r = run_controlled(
+        700.0,
+        stop,
+        no_offset,
+        &[give_way(), stand_on()],
+        controller,
+    );
+    let p = port(&r);
+    assert_eq!(p.situation.as_deref(), Some("crossing stand-on"), "{p:?}");
+    assert_eq!(p.t_stand_on_broken_s, None, "{p:?}");
+    assert_eq!(p.stand_on_excused_by.as_deref(), Some("starboard"), "{p:?}");
+    assert!(p.t_stand_on_excused_s.is_some_and(|t| t < 312.0), "{p:?}");
+    assert!(!metrics(&verdict(&r)).contains(&"rule17_stand_on"));
 }
 
 #[test]

@@ -215,6 +215,9 @@ struct Target {
     /// crossed to ahead of her by its own motion, while it keeps drawing away from
     /// that line ([`Target::watch_crossing`]).
     crossed_before: Option<f64>,
+    /// Before detection: the risk test ([`Target::watch_rule17`]) has held and the target
+    /// is not drawing away at this step.
+    risk_before_detection: bool,
     /// Each vessel's last side (non-zero) of the target's course line.
     prev_cross: [Option<f64>; 3],
     /// The other target (its index among the tracker's) the tow owes an action to at
@@ -285,6 +288,7 @@ impl Target {
             acting: false,
             prev_pose: None,
             crossed_before: None,
+            risk_before_detection: false,
             prev_cross: [None; 3],
             excused_by: None,
             excused_first: None,
@@ -298,9 +302,14 @@ impl Target {
         self.controller.or(self.det.map(|d| d.geometric))
     }
 
+    /// Whether the tow gives way to this target at this step: from detection, or before it
+    /// from the first step the risk test holds ([`Target::watch_rule17`]) once the
+    /// controller reads a give-way situation (it acts by the CPA, Rule 16: a give-way
+    /// vessel acts no later than her failure to would let the stand-on vessel act), until
+    /// the target is past and clear.
     fn open_give_way(&self) -> bool {
         self.present
-            && self.det.is_some()
+            && (self.det.is_some() || self.risk_before_detection)
             && self.r.t_past_and_clear_s.is_none()
             && self.situation().is_some_and(is_give_way)
     }
@@ -364,16 +373,24 @@ impl Target {
     /// stand-on vessel act as soon as the give-way vessel's failure is apparent, wherever
     /// it is (the guidance acts by the CPA, not by `d_detect`: random-12-0012's tow took
     /// its way off at a TCPA of 52 s, 2 s before the forward tug came within 7 m, and was
-    /// then judged on the speed it had kept at detection).
+    /// then judged on the speed it had kept at detection). The same test opens the give-way
+    /// duty before detection ([`Target::open_give_way`]), while the target is not drawing
+    /// away.
     fn watch_rule17(&mut self, t: f64, ship: &Vessel, o: &Obstacle, (d_detect, th): (f64, &Thresholds)) {
-        if self.det.is_some() || self.r.t_rule17_s.is_some() {
+        if self.det.is_some() {
             return;
         }
+        let (sp, tp) = ([ship.x, ship.y], [o.x, o.y]);
         let v_target = course_velocity(o.course, o.speed);
-        let (tcpa, dcpa) = cpa_tcpa([ship.x, ship.y], ship.vel_n(), [o.x, o.y], v_target);
-        if (0.0..=th.rule17_tcpa_s).contains(&tcpa) && dcpa < d_detect {
-            self.r.t_rule17_s = Some(t);
+        if self.r.t_rule17_s.is_none() {
+            let (tcpa, dcpa) = cpa_tcpa(sp, ship.vel_n(), tp, v_target);
+            if (0.0..=th.rule17_tcpa_s).contains(&tcpa) && dcpa < d_detect {
+                self.r.t_rule17_s = Some(t);
+            }
         }
+        // Beyond d_detect the only past-and-clear test is "gone" (drawing away).
+        self.risk_before_detection =
+            self.r.t_rule17_s.is_some() && !drawing_away(sp, ship.psi, tp, v_target);
     }
 
     /// Detection at this step if any vessel of the tow is within `d_detect`.
