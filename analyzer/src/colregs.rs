@@ -11,7 +11,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{relative_bearing, wrap};
+use crate::geometry::{line_coordinates, relative_bearing, wrap};
 
 /// Range and scoring parameters. The published values are full scale (e.g. `r_min`
 /// 100 m, `r_nm` 50 m, `r_col` 30 m); [`ScoringParams::model_scale`] derives them from
@@ -320,6 +320,18 @@ pub struct EncounterReport {
     pub params: ScoringParams,
 }
 
+/// Rule 15's "passed ahead of the target": own ship at the CPA bears from the target's
+/// bow between 25 deg to port and 165 deg to starboard (`-25 < alpha_cpa < 165`,
+/// reference/colregs.md), unless she got to its starboard side by crossing its course
+/// line astern of it (`crossed_astern`: her last crossing of the line before the CPA
+/// was abaft the target). A slow tow that passes astern of a crossing target and then
+/// resumes her route towards its wake reaches her least range on the target's starboard
+/// quarter, which the window alone reads as ahead (`docs/analyzer.md`).
+#[must_use]
+pub fn passed_ahead(alpha_cpa_deg: f64, crossed_astern: bool) -> bool {
+    alpha_cpa_deg > -25.0 && alpha_cpa_deg < 165.0 && !(crossed_astern && alpha_cpa_deg > 0.0)
+}
+
 /// Range score `s_r`: 1 at or above `r_min`, falling linearly by `gamma_nm` down to
 /// `r_nm` and by `gamma_col` down to `r_col`, 0 below.
 #[must_use]
@@ -336,7 +348,8 @@ pub fn range_score(r: f64, p: &ScoringParams) -> f64 {
     s.clamp(0.0, 1.0)
 }
 
-/// Scores from the encounter's key quantities (angles in deg).
+/// Scores from the encounter's key quantities (angles in deg); `ahead15`: own ship passed
+/// ahead of the target ([`passed_ahead`]).
 #[allow(clippy::too_many_arguments)]
 #[must_use]
 pub fn scores(
@@ -346,7 +359,7 @@ pub fn scores(
     r_manoeuvre: f64,
     dchi_starboard_deg: f64,
     dchi_port_deg: f64,
-    speed_change_rel: f64,
+    (speed_change_rel, ahead15): (f64, bool),
     p: &ScoringParams,
 ) -> Scores {
     let clip = |v: f64| v.clamp(0.0, 1.0);
@@ -380,11 +393,7 @@ pub fn scores(
     let sb = (1.0 - beta_cpa_deg.to_radians().sin()) / 2.0;
     let p_sts = 1.0 - (sa * sa) * (sb * sb);
     let rule14 = clip(1.0 - 0.6 * p_nsb - 0.2 * p_delay - p_sts) * (1.0 - p_na);
-    let p_ahead15 = if alpha_cpa_deg > -25.0 && alpha_cpa_deg < 165.0 {
-        1.0
-    } else {
-        0.0
-    };
+    let p_ahead15 = if ahead15 { 1.0 } else { 0.0 };
     let rule15 = clip(rule16 - 0.5 * p_ahead15);
     let p_ahead13 = if alpha_cpa_deg.abs() < 45.0 { 1.0 } else { 0.0 };
     let rule13 = clip(rule16 - 0.3 * p_ahead13);
@@ -457,6 +466,9 @@ struct Cpa {
     range: f64,
     sample: EncounterSample,
     window: Option<Window>,
+    /// Own ship's last crossing of the target's course line before the CPA was astern
+    /// of the target ([`passed_ahead`]).
+    crossed_astern: bool,
 }
 
 /// The assessment of one encounter fed one sample at a time (O(1) state, for a plant log
@@ -473,6 +485,10 @@ pub struct EncounterTracker {
     detect_tow: Option<EncounterSample>,
     window: Option<Window>,
     cpa: Option<Cpa>,
+    /// Own ship's last non-zero side of the target's course line (+ starboard).
+    side: Option<f64>,
+    /// Own ship's last crossing of that line was astern of the target.
+    crossed_astern: bool,
 }
 
 fn range_of(s: &EncounterSample) -> f64 {
@@ -490,6 +506,8 @@ impl EncounterTracker {
             detect_tow: None,
             window: None,
             cpa: None,
+            side: None,
+            crossed_astern: false,
         }
     }
 
@@ -542,12 +560,24 @@ impl EncounterTracker {
             }
             w.was_altered = altered;
         }
+        let (along, side) = line_coordinates(
+            [s.target[0], s.target[1]],
+            s.target[2],
+            [s.own[0], s.own[1]],
+        );
+        if side != 0.0 {
+            if self.side.is_some_and(|p| p * side < 0.0) {
+                self.crossed_astern = along < 0.0;
+            }
+            self.side = Some(side);
+        }
         if range.is_finite() && self.cpa.is_none_or(|c| range < c.range) {
             self.cpa = Some(Cpa {
                 index,
                 range,
                 sample: s,
                 window: self.window,
+                crossed_astern: self.crossed_astern,
             });
         }
     }
@@ -572,7 +602,10 @@ impl EncounterTracker {
             r_cpa,
             det_ship.as_ref(),
             controller,
-            cpa_rec.index + 1 == self.samples && self.samples > 1,
+            (
+                cpa_rec.index + 1 == self.samples && self.samples > 1,
+                cpa_rec.crossed_astern,
+            ),
             p,
         );
         let Some(det_ship) = det_ship else {
@@ -613,7 +646,7 @@ impl EncounterReport {
         r_cpa: f64,
         det_ship: Option<&EncounterSample>,
         controller: Option<&ControllerView>,
-        at_end: bool,
+        (at_end, crossed_astern): (bool, bool),
         p: &ScoringParams,
     ) -> (Self, Option<Situation>) {
         let beta_cpa = cpa.bearing().to_degrees();
@@ -671,7 +704,7 @@ impl EncounterReport {
             beta_cpa_deg: beta_cpa,
             alpha_cpa_deg: alpha_cpa,
             side: if beta_cpa >= 0.0 { "starboard" } else { "port" }.to_owned(),
-            passed: if alpha_cpa > -25.0 && alpha_cpa < 165.0 {
+            passed: if passed_ahead(alpha_cpa, crossed_astern) {
                 "ahead"
             } else {
                 "astern"
@@ -762,7 +795,7 @@ fn judge(
         r_manoeuvre,
         stbd,
         port,
-        speed_change,
+        (speed_change, report.passed == "ahead"),
         p,
     );
 
@@ -878,6 +911,20 @@ mod tests {
         let i_det = samples[..=i_cpa]
             .iter()
             .position(|s| range(s) < p.r_detect_m);
+        // Own ship's side of the target's course line at each sample up to the CPA; the
+        // last change of side, and where along the line it was.
+        let line = |s: &EncounterSample| {
+            line_coordinates(
+                [s.target[0], s.target[1]],
+                s.target[2],
+                [s.own[0], s.own[1]],
+            )
+        };
+        let crossed_astern = samples[..=i_cpa]
+            .windows(2)
+            .rev()
+            .find(|w| line(&w[0]).1 * line(&w[1]).1 < 0.0)
+            .is_some_and(|w| line(&w[1]).0 < 0.0);
         let (mut report, assessed) = EncounterReport::at_cpa(
             target,
             slot,
@@ -885,7 +932,10 @@ mod tests {
             r_cpa,
             i_det.map(|i| &samples[i]),
             controller,
-            i_cpa + 1 == samples.len() && samples.len() > 1,
+            (
+                i_cpa + 1 == samples.len() && samples.len() > 1,
+                crossed_astern,
+            ),
             p,
         );
         let Some(i_det) = i_det else {
@@ -1099,6 +1149,57 @@ mod tests {
         assert!(a.score.expect("score") > h.score.expect("score"));
         // Geometry at detection agrees with the controller.
         assert_eq!(a.situation_geometric.as_deref(), Some("crossing give-way"));
+    }
+
+    #[test]
+    fn crossing_astern_then_closing_on_the_starboard_quarter_is_no_pass_ahead() {
+        // Target from the starboard bow (8 m ahead, 3 m to starboard) crosses West at
+        // 0.05 m/s. Own ship (0.1 m/s) alters 75 deg to starboard at 20 s, crosses the
+        // target's course line astern of it (about 143 s) after turning back 45 deg to
+        // port of her route at 80 s, and reaches her least range (5.3 m, 164 s) on the
+        // target's starboard quarter: alpha_cpa about 164 deg, inside the window
+        // (-25, 165) that alone reads it as a pass ahead (reana of random-12-0028, -0034,
+        // -0265, -0425, -0432: "passed ahead" after passing astern).
+        let p = params();
+        let view = give_way_view(Situation::CrossingGiveWay);
+        let course = -PI / 2.0;
+        let (mut x, mut y) = (0.0, 0.0);
+        let mut samples = Vec::new();
+        for k in 0..800 {
+            let t = f64::from(k) * 0.5;
+            let psi = match t {
+                t if t < 20.0 => 0.0,
+                t if t < 80.0 => 75f64.to_radians(),
+                _ => -45f64.to_radians(),
+            };
+            samples.push(EncounterSample {
+                t,
+                own: [x, y, psi, 0.1],
+                target: [8.0, 3.0 - 0.05 * t, course, 0.05],
+                altered: Some(t >= 20.0),
+                tow_range: f64::INFINITY,
+                route_course: 0.0,
+            });
+            x += 0.1 * 0.5 * psi.cos();
+            y += 0.1 * 0.5 * psi.sin();
+        }
+        let a = assess("A", 4, &samples, Some(&view), &p).expect("report");
+        assert_eq!(a.situation_geometric.as_deref(), Some("crossing give-way"));
+        assert!((150.0..180.0).contains(&a.t_cpa_s), "{}", a.t_cpa_s);
+        assert!(
+            a.alpha_cpa_deg > 90.0 && a.alpha_cpa_deg < 165.0,
+            "{}",
+            a.alpha_cpa_deg
+        );
+        assert_eq!(a.passed, "astern");
+        assert!(
+            !a.reasons.iter().any(|r| r.contains("ahead")),
+            "{:?}",
+            a.reasons
+        );
+        assert_eq!(a.scores.expect("scores").p_ahead_rule15, 0.0);
+        // Without the crossing astern the window alone reads the same CPA as a pass ahead.
+        assert!(passed_ahead(a.alpha_cpa_deg, false));
     }
 
     #[test]
