@@ -11,7 +11,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{line_coordinates, relative_bearing, wrap};
+use crate::geometry::{course_line_crossing, relative_bearing, wrap};
 
 /// Range and scoring parameters. The published values are full scale (e.g. `r_min`
 /// 100 m, `r_nm` 50 m, `r_col` 30 m); [`ScoringParams::model_scale`] derives them from
@@ -560,16 +560,11 @@ impl EncounterTracker {
             }
             w.was_altered = altered;
         }
-        let (along, side) = line_coordinates(
-            [s.target[0], s.target[1]],
-            s.target[2],
-            [s.own[0], s.own[1]],
-        );
-        if side != 0.0 {
-            if self.side.is_some_and(|p| p * side < 0.0) {
-                self.crossed_astern = along < 0.0;
-            }
-            self.side = Some(side);
+        let own = [s.own[0], s.own[1]];
+        if let Some(along) =
+            course_line_crossing(&mut self.side, [s.target[0], s.target[1]], s.target[2], own)
+        {
+            self.crossed_astern = along < 0.0;
         }
         if range.is_finite() && self.cpa.is_none_or(|c| range < c.range) {
             self.cpa = Some(Cpa {
@@ -914,7 +909,7 @@ mod tests {
         // Own ship's side of the target's course line at each sample up to the CPA; the
         // last change of side, and where along the line it was.
         let line = |s: &EncounterSample| {
-            line_coordinates(
+            crate::geometry::line_coordinates(
                 [s.target[0], s.target[1]],
                 s.target[2],
                 [s.own[0], s.own[1]],

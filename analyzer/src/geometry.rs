@@ -14,6 +14,26 @@ pub use towing_model::geometry::{
 /// A point `[north, east]`, m.
 pub type P2 = towing_model::geometry::Point;
 
+/// A crossing of a target's course line (through `target` on `course`) by the point
+/// `own`: `last_side` is own point's last non-zero side of the line (+ starboard of the
+/// target), updated here; when the side changed since, own point's position along the
+/// line (+ ahead of the target), else `None`. Rule 15's crossing ahead (the `rules`
+/// metric) and "passed ahead" (the `colregs` scorer) read it.
+#[must_use]
+pub fn course_line_crossing(
+    last_side: &mut Option<f64>,
+    target: P2,
+    course: f64,
+    own: P2,
+) -> Option<f64> {
+    let (along, side) = line_coordinates(target, course, own);
+    if side == 0.0 {
+        return None;
+    }
+    let changed = last_side.replace(side).is_some_and(|p| p * side < 0.0);
+    changed.then_some(along)
+}
+
 /// The course of the tow's manoeuvre, against which her course changes are measured:
 /// following her route ([`Polyline::course_ahead`], `route_course_lookahead_m` ahead).
 /// COLREGS Rule 17's "course" is that of the manoeuvre the vessel is engaged in, not

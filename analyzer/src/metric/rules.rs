@@ -72,7 +72,7 @@ use crate::error::Result;
 use crate::colregs::{classify, Situation};
 use crate::geometry::{
     abaft_and_opening, course_velocity, cpa_tcpa, crossed_ahead, dist, drawing_away,
-    hull_ellipse_clearance, line_coordinates, relative_bearing, wrap, RouteCourse,
+    course_line_crossing, hull_ellipse_clearance, line_coordinates, relative_bearing, wrap, RouteCourse,
 };
 use crate::rows::VESSELS;
 use crate::step::{Obstacle, ObstacleKind, PlantStep, RunGeometry, Vessel};
@@ -536,16 +536,13 @@ impl Target {
     fn cross_ahead(&mut self, t: f64, vessels: &[Vessel; 3], o: &Obstacle, th: &Thresholds) {
         let tp = [o.x, o.y];
         for (k, v) in vessels.iter().enumerate() {
-            let (along, side) = line_coordinates(tp, o.course, [v.x, v.y]);
-            let prev = self.prev_cross[k];
-            if side != 0.0 {
-                self.prev_cross[k] = Some(side);
-            }
-            let changed = prev.is_some_and(|p| p * side < 0.0);
+            let crossed = course_line_crossing(&mut self.prev_cross[k], tp, o.course, [v.x, v.y]);
             let range = dist([v.x, v.y], tp);
-            if !(changed && along > 0.0 && range < th.cross_ahead_min_m) {
+            if !(crossed.is_some_and(|along| along > 0.0) && range < th.cross_ahead_min_m) {
                 continue;
             }
+            // The side it crossed to (+ the target's starboard).
+            let side = self.prev_cross[k].unwrap_or(0.0);
             let crossing = CrossAhead {
                 t_s: t,
                 vessel: VESSELS[k].to_owned(),
