@@ -266,13 +266,7 @@ fn seamanship_sideways_drift_45_deg() {
 
 #[test]
 fn seamanship_stall_of_200_s_is_a_reason() {
-    let stop = |t: f64, p: [f64; 2]| {
-        if t > 300.0 && t <= 500.0 {
-            (0.0, 0.0, 0.0)
-        } else {
-            cruise(t, p)
-        }
-    };
+    let stop = stop_between(300.0, 500.0);
     let r = run(1000.0, stop, no_offset, &[]);
     let stall = r.progress.longest_stall.expect("a stall");
     // 200 s stopped plus at most the time to cover 0.5 m at cruise around it.
@@ -296,10 +290,10 @@ fn crossing_from_starboard() -> Target {
     }
 }
 
-/// The tow stops at 300 s (x = 19.5 m) and resumes at `resume` s.
-fn stop_until(resume: f64) -> impl Fn(f64, [f64; 2]) -> (f64, f64, f64) {
+/// At cruise along the route, stopped from `from` s (at 300 s: x = 19.5 m) to `resume` s.
+fn stop_between(from: f64, resume: f64) -> impl Fn(f64, [f64; 2]) -> (f64, f64, f64) + Copy {
     move |t, p| {
-        if t > 300.0 && t <= resume {
+        if t > from && t <= resume {
             (0.0, 0.0, 0.0)
         } else {
             cruise(t, p)
@@ -311,7 +305,7 @@ fn stop_until(resume: f64) -> impl Fn(f64, [f64; 2]) -> (f64, f64, f64) {
 fn seamanship_stall_while_giving_way_is_excused_and_a_correct_give_way_passes() {
     let r = run(
         1000.0,
-        stop_until(500.0),
+        stop_between(300.0, 500.0),
         no_offset,
         &[crossing_from_starboard()],
     );
@@ -342,7 +336,7 @@ fn seamanship_give_way_given_up_before_the_target_is_past() {
     // Resumes at 450 s with the target 2 m East of the route, on the starboard bow.
     let r = run(
         1000.0,
-        stop_until(450.0),
+        stop_between(300.0, 450.0),
         no_offset,
         &[crossing_from_starboard()],
     );
@@ -367,14 +361,14 @@ fn seamanship_give_way_given_up_before_the_target_is_past() {
     assert!(metrics(&why).contains(&"rule15_give_way"), "{why:?}");
 }
 
-/// Stopped from 300 s as [`stop_until`]; from 450 s at cruise again, bringing her head
+/// Stopped from 300 s as [`stop_between`]; from 450 s at cruise again, bringing her head
 /// round to starboard at 2 deg/s to `to_deg`.
 fn resume_swinging(to_deg: f64) -> impl Fn(f64, [f64; 2]) -> (f64, f64, f64) {
     move |t, p| {
         if t > 450.0 {
             ((2.0 * (t - 450.0)).min(to_deg), CRUISE, 0.0)
         } else {
-            stop_until(450.0)(t, p)
+            stop_between(300.0, 450.0)(t, p)
         }
     }
 }
@@ -748,7 +742,12 @@ fn seamanship_a_crossing_seen_before_detection_counts_at_detection() {
         course_deg: 210.0,
         speed: 0.05,
     };
-    let r = run(600.0, stop_until(2000.0), no_offset, &[crossed_early]);
+    let r = run(
+        600.0,
+        stop_between(300.0, 2000.0),
+        no_offset,
+        &[crossed_early],
+    );
     let target = &r.rules.targets[0];
     let t_detect = target.t_detect_s.expect("detected");
     assert!(t_detect > 340.0, "{t_detect}");
@@ -947,13 +946,7 @@ fn seamanship_a_give_way_action_taken_by_the_cpa_before_detection_excuses_the_st
         course_deg: 90.0,
         speed: 0.01,
     };
-    let stop = |t: f64, p: [f64; 2]| {
-        if t > 310.0 && t <= 380.0 {
-            (0.0, 0.0, 0.0)
-        } else {
-            cruise(t, p)
-        }
-    };
+    let stop = stop_between(310.0, 380.0);
     // The controller reads the starboard target (slot 1) as crossing give-way from 310 s.
     let controller = |t: f64| {
         Some(ControlSample {
@@ -1011,13 +1004,7 @@ fn seamanship_a_target_drawing_ahead_along_the_heading_line_is_gone() {
         course_deg: 0.0,
         speed: 0.04,
     };
-    let stop = |t: f64, p: [f64; 2]| {
-        if t > 140.0 && t <= 300.0 {
-            (0.0, 0.0, 0.0)
-        } else {
-            cruise(t, p)
-        }
-    };
+    let stop = stop_between(140.0, 300.0);
     let r = run(600.0, stop, no_offset, &[ahead]);
     let target = &r.rules.targets[0];
     assert_eq!(
