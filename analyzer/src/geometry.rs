@@ -70,6 +70,23 @@ impl RouteCourse {
             .and_then(|r| r.course_ahead(p, self.lookahead))
             .unwrap_or(0.0)
     }
+
+    /// How far `p` lies to starboard of the route (m, negative to port): its distance
+    /// from its nearest point on the route, signed by that segment's starboard normal; 0
+    /// without a route or at a non-finite `p`.
+    #[must_use]
+    pub fn cross_track(&self, p: P2) -> f64 {
+        let Some(route) = self
+            .route
+            .as_ref()
+            .filter(|_| p[0].is_finite() && p[1].is_finite())
+        else {
+            return 0.0;
+        };
+        let at = route.project(p);
+        let n = route.starboard_normal(at.segment);
+        (p[0] - at.point[0]) * n[0] + (p[1] - at.point[1]) * n[1]
+    }
 }
 
 /// Wraps an angle to `(-pi, pi]`.

@@ -43,6 +43,11 @@ pub struct Thresholds {
     /// heading at detection, comes round to starboard at this yaw rate or more, deg/s
     /// (the tow gathering way as she alters: docs/analyzer.md).
     pub give_way_turn_rate_deg_s: f64,
+    /// Give-way: an alteration is still held while the ship keeps the offset to
+    /// starboard of her route she has gained since detection, giving back no more than
+    /// this of it, and more than this remains, m (about the ship's beam, 0.29 m; the
+    /// tow steadied on a track parallel to her route holds her action: docs/analyzer.md).
+    pub give_way_offset_m: f64,
     /// Give-way: the way is off at this surge speed or less, m/s.
     pub way_off_surge_m_s: f64,
     /// Give-way: no vessel of the tow crosses ahead of a give-way target closer than
@@ -82,6 +87,7 @@ impl Default for Thresholds {
             waterway_tolerance_m: 0.0,
             give_way_turn_deg: 10.0,
             give_way_turn_rate_deg_s: 1.0,
+            give_way_offset_m: 0.3,
             way_off_surge_m_s: 0.05,
             cross_ahead_min_m: 7.0,
             head_on_turn_deg: 10.0,
@@ -98,7 +104,7 @@ impl Default for Thresholds {
 impl Thresholds {
     /// Every threshold with its name, in declaration order.
     #[must_use]
-    pub fn entries(&self) -> [(&'static str, f64); 21] {
+    pub fn entries(&self) -> [(&'static str, f64); 22] {
         [
             ("progress_min_m", self.progress_min_m),
             ("destination_radius_m", self.destination_radius_m),
@@ -112,6 +118,7 @@ impl Thresholds {
             ("waterway_tolerance_m", self.waterway_tolerance_m),
             ("give_way_turn_deg", self.give_way_turn_deg),
             ("give_way_turn_rate_deg_s", self.give_way_turn_rate_deg_s),
+            ("give_way_offset_m", self.give_way_offset_m),
             ("way_off_surge_m_s", self.way_off_surge_m_s),
             ("cross_ahead_min_m", self.cross_ahead_min_m),
             ("head_on_turn_deg", self.head_on_turn_deg),

@@ -627,6 +627,54 @@ fn seamanship_head_on_starboard_to_starboard_is_a_reason() {
     assert!(metrics(&why).contains(&"rule16_action"), "{why:?}");
 }
 
+/// Along the route at cruise speed: 20 deg to starboard from 40 s to 100 s (1.33 m gained),
+/// then parallel to the route, and from `back` s 20 deg to port for 60 s.
+fn overtake_to_starboard(back: f64) -> impl Fn(f64, [f64; 2]) -> (f64, f64, f64) {
+    move |t, p| {
+        let psi = if (40.0..100.0).contains(&t) {
+            20.0
+        } else if (back..back + 60.0).contains(&t) {
+            -20.0
+        } else {
+            0.0
+        };
+        (psi, if p[0] < 50.0 { CRUISE } else { 0.0 }, 0.0)
+    }
+}
+
+#[test]
+fn seamanship_an_offset_held_parallel_to_the_route_holds_the_overtaking_action() {
+    // A slower target ahead on the route: the tow alters 20 deg to starboard, then runs
+    // parallel to her route 1.33 m to starboard of it until she is past. Her head is
+    // back on the route's course from 100 s, long before the target is abaft her beam:
+    // the offset she keeps is her action (Rule 8(d)).
+    let slow = || Target {
+        name: "slow",
+        at_t0: [10.0, 0.0],
+        course_deg: 0.0,
+        speed: 0.03,
+    };
+    let r = run(
+        900.0,
+        overtake_to_starboard(f64::INFINITY),
+        no_offset,
+        &[slow()],
+    );
+    let target = &r.rules.targets[0];
+    assert_eq!(target.situation.as_deref(), Some("overtaking"));
+    assert_eq!(target.action.as_deref(), Some("starboard alteration"));
+    assert_eq!(target.given_up, None, "{target:?}");
+    let passed = target.t_past_and_clear_s.expect("passed");
+    assert!(passed > 200.0, "{target:?}");
+    assert!(!metrics(&verdict(&r)).contains(&"rule8_past_and_clear"));
+    // Turning back towards the route at 150 s, before the target is past: given up once
+    // she has given back 0.3 m of the offset (0.022 m/s across the route: 13.6 s).
+    let r = run(900.0, overtake_to_starboard(150.0), no_offset, &[slow()]);
+    let g = r.rules.targets[0].given_up.expect("given up");
+    assert!(g.t_s > 160.0 && g.t_s < 165.0, "{g:?}");
+    assert!(metrics(&verdict(&r)).contains(&"rule8_past_and_clear"));
+}
+
 #[test]
 fn seamanship_overtaking_too_close_is_a_reason() {
     // A slower target on the same course 0.5 m to starboard of the route: side by side,

@@ -18,7 +18,10 @@
 //!   detection or the way off (surge <= `way_off_surge_m_s`); held until the target is
 //!   past and clear (Rule 8(d)), else "given up" (`rule8_past_and_clear`); a head to
 //!   starboard of its detection heading still coming round at `give_way_turn_rate_deg_s`
-//!   or more holds it too (the tow gathering way as she alters);
+//!   or more holds it too (the tow gathering way as she alters), and so does, once she
+//!   has altered, the offset to starboard of her route gained since detection, while she
+//!   gives back no more than `give_way_offset_m` of it and more than that remains (a tow
+//!   steadied on a track parallel to her route keeps her action);
 //! - no vessel of the tow crosses ahead of a give-way target closer than
 //!   `cross_ahead_min_m` (Rule 15: "avoid crossing ahead"; the same check for overtaking
 //!   under Rule 13; head-on, only a crossing onto the target's starboard side counts,
@@ -196,6 +199,9 @@ struct Detection {
     /// The ship's heading less the route's course ([`RouteCourse`]), rad: course changes
     /// are measured from it.
     off_course: f64,
+    /// The ship's offset to starboard of her route ([`RouteCourse::cross_track`]), m:
+    /// the offset an alteration gains is measured from it.
+    cross_track: f64,
     sog: f64,
     geometric: Situation,
 }
@@ -208,6 +214,8 @@ struct Target {
     det: Option<Detection>,
     controller: Option<Situation>,
     stbd_max: f64,
+    /// The largest offset to starboard of her route gained since detection, m.
+    offset_max: f64,
     acting: bool,
     /// The ship's position and heading, and the target's position, at the previous step.
     prev_pose: Option<([f64; 2], f64, [f64; 2])>,
@@ -232,6 +240,15 @@ struct Target {
 
 /// Own vessels with the sizes, as the checks need them.
 type Tow<'s> = (&'s [Vessel; 3], &'s [[f64; 2]; 3]);
+
+/// The ship against her route at a step ([`RouteCourse`]).
+#[derive(Debug, Clone, Copy)]
+struct Track {
+    /// The route's course, rad.
+    course: f64,
+    /// The ship's offset to starboard of the route, m.
+    cross_track: f64,
+}
 
 /// The target's side of the ship's heading line and its own velocity across that line
 /// (both + starboard): it draws away from the line when their product is positive.
@@ -285,6 +302,7 @@ impl Target {
             det: None,
             controller: None,
             stbd_max: 0.0,
+            offset_max: 0.0,
             acting: false,
             prev_pose: None,
             crossed_before: None,
@@ -394,7 +412,14 @@ impl Target {
     }
 
     /// Detection at this step if any vessel of the tow is within `d_detect`.
-    fn detect(&mut self, t: f64, (ship, course): (&Vessel, f64), vessels: &[Vessel; 3], o: &Obstacle, d: f64) {
+    fn detect(
+        &mut self,
+        t: f64,
+        (ship, track): (&Vessel, Track),
+        vessels: &[Vessel; 3],
+        o: &Obstacle,
+        d: f64,
+    ) {
         let tp = [o.x, o.y];
         if self.det.is_some() || !any_within(vessels, tp, d) {
             return;
@@ -404,7 +429,8 @@ impl Target {
         let alpha = relative_bearing(tp, o.course, sp).to_degrees();
         let geometric = classify(beta, alpha, ship.sog(), o.speed);
         self.det = Some(Detection {
-            off_course: ship.psi - course,
+            off_course: ship.psi - track.course,
+            cross_track: track.cross_track,
             sog: ship.sog(),
             geometric,
         });
@@ -419,7 +445,7 @@ impl Target {
     fn observe(
         &mut self,
         t: f64,
-        (tow, course, d_detect): (Tow<'_>, f64, f64),
+        (tow, track, d_detect): (Tow<'_>, Track, f64),
         o: &Obstacle,
         th: &Thresholds,
     ) {
@@ -430,7 +456,8 @@ impl Target {
         let range = dist(sp, tp);
         let beta = relative_bearing(sp, ship.psi, tp).to_degrees();
         // The course change: the heading's, less the route's own turn (a bend).
-        let turn = wrap(ship.psi - course - det.off_course).to_degrees();
+        let turn = wrap(ship.psi - track.course - det.off_course).to_degrees();
+        let gained = track.cross_track - det.cross_track;
         self.stbd_max = self.stbd_max.max(turn);
         if self.r.r_cpa_m.is_none_or(|r| range < r) {
             self.r.t_cpa_s = Some(t);
@@ -439,7 +466,7 @@ impl Target {
             self.r.starboard_turn_to_cpa_deg = Some(self.stbd_max);
         }
         self.past_and_clear(t, (tow.0, d_detect), o, th);
-        self.give_way_action(t, &ship, (range, beta, turn), th);
+        self.give_way_action(t, &ship, (range, beta, turn, gained), th);
         self.cross_ahead(t, tow.0, o, th);
         self.stand_on(t, &ship, v_target, o, (turn, beta), th);
         self.clearance(t, tow, o);
@@ -498,10 +525,20 @@ impl Target {
         &mut self,
         t: f64,
         ship: &Vessel,
-        (range, beta, turn): (f64, f64, f64),
+        (range, beta, turn, gained): (f64, f64, f64, f64),
         th: &Thresholds,
     ) {
         let turned = turn >= th.give_way_turn_deg;
+        // An alteration made (the head once `give_way_turn_deg` to starboard) is held
+        // while the offset it gained is: the tow steadied on a track parallel to her
+        // route, to starboard of where she was, has not turned back towards the target
+        // (the action of Rule 8(d) is the passing distance it makes, and a narrow
+        // waterway leaves no room to hold the heading itself for a long overtaking).
+        self.offset_max = self.offset_max.max(gained);
+        let slack = th.give_way_offset_m;
+        let offset_kept = self.stbd_max >= th.give_way_turn_deg
+            && gained > slack
+            && gained >= self.offset_max - slack;
         let way_off = ship.u <= th.way_off_surge_m_s;
         let acting = turned || way_off;
         // An alteration to starboard under way: the head already to starboard of its
@@ -520,7 +557,7 @@ impl Target {
                 .to_owned(),
             );
         }
-        let released = self.acting && !acting && !swinging;
+        let released = self.acting && !acting && !swinging && !offset_kept;
         if released && self.r.t_past_and_clear_s.is_none() && self.r.given_up.is_none() {
             self.r.given_up = Some(GiveUp {
                 t_s: t,
@@ -528,7 +565,7 @@ impl Target {
                 bearing_deg: beta,
             });
         }
-        self.acting = acting || (self.acting && swinging);
+        self.acting = acting || (self.acting && (swinging || offset_kept));
     }
 
     /// Rule 15: a vessel of the tow crossing the target's course line ahead of it, close
@@ -691,7 +728,10 @@ impl RulesTracker {
             t.excused_by = if first == Some(k) { second } else { first };
         }
         let ship = step.vessels[0];
-        let course = self.course.at([ship.x, ship.y]);
+        let track = Track {
+            course: self.course.at([ship.x, ship.y]),
+            cross_track: self.course.cross_track([ship.x, ship.y]),
+        };
         for o in step
             .obstacles
             .iter()
@@ -709,10 +749,10 @@ impl RulesTracker {
             target.watch_controller(step);
             target.watch_crossing(&ship, o);
             target.watch_rule17(step.t, &ship, o, (self.d_detect, &self.th));
-            target.detect(step.t, (&ship, course), &step.vessels, o, self.d_detect);
+            target.detect(step.t, (&ship, track), &step.vessels, o, self.d_detect);
             target.observe(
                 step.t,
-                ((&step.vessels, &self.sizes), course, self.d_detect),
+                ((&step.vessels, &self.sizes), track, self.d_detect),
                 o,
                 &self.th,
             );

@@ -682,7 +682,7 @@ impl Controller {
         let heading_floor = self.heading_floor(m);
         let reference = self.reference(
             m,
-            (guidance.active_waypoint, target),
+            (guidance.active_waypoint, target, guidance.offset_held),
             altered,
             lookahead,
             heading_floor,
@@ -880,7 +880,7 @@ impl Controller {
     fn reference(
         &mut self,
         m: &Measurement,
-        (active, target): (usize, Pose),
+        (active, target, offset_held): (usize, Pose, f64),
         altered: bool,
         lookahead: f64,
         floor: Option<f64>,
@@ -918,6 +918,9 @@ impl Controller {
             }
         }
         let leg = (points[active - 1].position(), points[active].position());
+        if altered {
+            goal = lift_to_offset(goal, leg, offset_held);
+        }
         let goal = self.clear_of_hazards(ship, goal, leg, &m.obstacles);
         let reference = self.steer(ship, goal, floor);
         self.short_of_hazards(ship, reference, &m.obstacles)
@@ -1349,6 +1352,26 @@ impl Controller {
 
 /// The angle `to`, or the one at most `max` (rad, > 0) from `from` towards it, wrapped to
 /// `(-pi, pi]`.
+/// `goal` moved square to the segment `leg` to `offset` m to its starboard side if it
+/// lies nearer the route than that (the offset the tow has gained while altered,
+/// [`towing_guidance::GuidanceOutput::offset_held`]); else `goal`. The tracked point
+/// of an alteration never lies to port of the track the tow has reached: past each
+/// waypoint the altered leg starts on the route again, and its point lay up to 14 deg
+/// to port of the route for a tow already 1.6-3.2 m to starboard of it, which turned
+/// her back towards the vessel she was overtaking (random-12-0067, 0069, 0147,
+/// `docs/colregs.md` section 2, step 7).
+fn lift_to_offset(goal: [f64; 3], leg: ([f64; 2], [f64; 2]), offset: f64) -> [f64; 3] {
+    let (a, b) = leg;
+    let r = (b[0] - a[0]).hypot(b[1] - a[1]);
+    if offset <= 0.0 || r <= 0.0 {
+        return goal;
+    }
+    let n = [-(b[1] - a[1]) / r, (b[0] - a[0]) / r];
+    let across = (goal[0] - a[0]) * n[0] + (goal[1] - a[1]) * n[1];
+    let lift = (offset - across).max(0.0);
+    [goal[0] + lift * n[0], goal[1] + lift * n[1], goal[2]]
+}
+
 fn turn_towards(from: f64, to: f64, max: f64) -> f64 {
     wrap_angle(from + wrap_angle(to - from).clamp(-max, max))
 }
@@ -1497,4 +1520,23 @@ fn prediction_models(
             )
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::lift_to_offset;
+
+    #[test]
+    fn a_tracked_point_nearer_the_route_than_the_offset_held_is_lifted_to_it() {
+        // A northbound leg; East is starboard.
+        let leg = ([0.0, 0.0], [10.0, 0.0]);
+        let lifted = lift_to_offset([5.0, 0.5, 0.3], leg, 1.5);
+        assert_eq!(lifted, [5.0, 1.5, 0.3]);
+        // Already as far to starboard, or nothing held: unchanged.
+        assert_eq!(lift_to_offset([5.0, 2.0, 0.3], leg, 1.5), [5.0, 2.0, 0.3]);
+        assert_eq!(lift_to_offset([5.0, -1.0, 0.3], leg, 0.0), [5.0, -1.0, 0.3]);
+        // A point to port of the route goes square to the leg.
+        let lifted = lift_to_offset([5.0, -1.0, 0.3], leg, 1.5);
+        assert!((lifted[0] - 5.0).abs() < 1e-15 && (lifted[1] - 1.5).abs() < 1e-15);
+    }
 }

@@ -576,6 +576,13 @@ fn keeps_course(a: &ObstacleAssessment) -> bool {
 pub struct GuidanceOutput {
     /// Reference pose `eta_Sd = [x, y, psi]` for the controller (eq. (8)).
     pub eta_sd: Pose,
+    /// While altered, the largest offset to starboard of the active segment the ship has
+    /// reached since the alteration began or the segment became active (m, bounded by
+    /// the offset of an altered waypoint at `theta_max` with a waterway); 0 otherwise.
+    /// A point tracked on the altered leg lies no nearer the route than this
+    /// (`docs/colregs.md` section 2, step 7): the tow never steers back towards the
+    /// target while her action is held (Rule 8(d)).
+    pub offset_held: f64,
     /// The predefined (unaltered) active waypoint `eta_Sp`.
     pub route_waypoint: Pose,
     /// Index of the active waypoint in [`Route::points`] (1 = `W_P1`; the last is
@@ -633,6 +640,10 @@ pub struct ReferenceSystem {
     #[serde(skip)]
     params: GuidanceParams,
     active: usize,
+    /// The offset to starboard of the active segment held while altered, m
+    /// ([`GuidanceOutput::offset_held`]).
+    #[serde(default)]
+    offset_held: f64,
     encounters: Encounters,
 }
 
@@ -702,6 +713,7 @@ impl ReferenceSystem {
             route,
             params,
             active: 1,
+            offset_held: 0.0,
             encounters: Encounters::new(),
         }
     }
@@ -731,6 +743,7 @@ impl ReferenceSystem {
     /// Back to the start of the route, no encounter.
     pub fn reset(&mut self) {
         self.active = 1;
+        self.offset_held = 0.0;
         self.encounters = Encounters::new();
     }
 
@@ -814,6 +827,24 @@ impl ReferenceSystem {
         } else {
             (points[p], 0.0)
         }
+    }
+
+    /// The ship's offset to starboard of segment `p` (her signed distance from the
+    /// segment's line), bounded to `[0, r sin(theta_max)]` with a waterway (`r` the
+    /// segment's length, `theta_max` the paper's bound on `theta`: the farthest an
+    /// altered waypoint of the segment lies from the route, inside the waterway) and to
+    /// `[0, inf)` without one.
+    fn offset_to_starboard(&self, ship: [f64; 2], p: usize) -> f64 {
+        let points = self.route.points();
+        let (a, b) = (points[p - 1], points[p]);
+        let r = self.route.segment_length(p);
+        let n = [-(b.y - a.y) / r, (b.x - a.x) / r];
+        let offset = (ship[0] - a.x) * n[0] + (ship[1] - a.y) * n[1];
+        let bound = match self.params.settings().waterway_half_width {
+            Some(d2) => r * theta_max(r, d2).sin(),
+            None => f64::INFINITY,
+        };
+        offset.clamp(0.0, bound)
     }
 
     /// Whether the ship has reached the reference waypoint `target` of segment `p`:
@@ -1030,12 +1061,22 @@ impl ReferenceSystem {
         let ship = tow.ship.position();
         let last = self.route.last_index();
         let (mut target, mut theta) = self.reference(self.active, altered);
+        let before = self.active;
         while self.active < last && self.reached(ship, self.active, target, altered) {
             self.active += 1;
             (target, theta) = self.reference(self.active, altered);
         }
+        // Step 7: the offset gained while altered is held (of the new segment's line
+        // once the active waypoint advances).
+        let offset = self.offset_to_starboard(ship, self.active);
+        self.offset_held = match (altered, self.active == before) {
+            (false, _) => 0.0,
+            (true, true) => self.offset_held.max(offset),
+            (true, false) => offset,
+        };
         Ok(GuidanceOutput {
             eta_sd: target,
+            offset_held: self.offset_held,
             route_waypoint: self.route.points()[self.active],
             active_waypoint: self.active,
             altered,
@@ -1194,6 +1235,45 @@ mod tests {
     /// would let the stand-on vessel act (closing, TCPA <= 55 s, DCPA < 2.5 m), even
     /// with the target still beyond d_D; the encounter is then held as one detected
     /// within it. A target passing wide is no risk and gets no action beyond d_D.
+    #[test]
+    fn the_offset_gained_while_altered_is_held_and_bounded_by_the_waterway() {
+        // A straight northbound route with a waypoint every 6 m (as the random
+        // encounters' routes), the waterway 4.5 m wide each side: an altered waypoint of
+        // a segment lies at most 6 sin(theta_max) = 6 * 0.6 = 3.6 m off the route.
+        let route =
+            Route::from_positions(&[[0.0, 0.0], [6.0, 0.0], [12.0, 0.0], [18.0, 0.0]]).unwrap();
+        let settings = GuidanceSettings {
+            waterway_half_width: Some(4.5),
+            ..GuidanceSettings::default()
+        };
+        let mut rs = ReferenceSystem::new(route, GuidanceParams::new(settings).unwrap());
+        // A slow target ahead on the same course: the tow overtakes it, keeping out of
+        // its way to starboard.
+        let mut at = |x: f64, y: f64| {
+            let ship = Pose::new(x, y, deg(10.0));
+            let target = vessel(x + TUG2_AHEAD + 4.0, 0.2, 0.0, 0.03);
+            rs.update(&tow_at(ship, 0.1), &[target]).unwrap()
+        };
+        let out = at(2.0, 0.0);
+        assert!(out.altered && out.offset_held == 0.0);
+        // Gained 1.2 m, then 0.4 m given back: 1.2 m held.
+        assert!((at(3.0, 1.2).offset_held - 1.2).abs() < 1e-12);
+        let out = at(3.5, 0.8);
+        assert!((out.offset_held - 1.2).abs() < 1e-12);
+        assert_eq!(out.active_waypoint, 1);
+        // Past W_1N: the next segment's offset from where she is.
+        let out = at(6.5, 1.7);
+        assert_eq!(out.active_waypoint, 2);
+        assert!((out.offset_held - 1.7).abs() < 1e-12);
+        // Never beyond the waterway's bound.
+        assert!((at(8.0, 5.0).offset_held - 3.6).abs() < 1e-12);
+        // Not altered: none.
+        let ship = Pose::new(9.0, 1.7, 0.0);
+        let gone = vessel(-40.0, 0.0, PI, 0.03);
+        let out = rs.update(&tow_at(ship, 0.1), &[gone]).unwrap();
+        assert!(!out.altered && out.offset_held == 0.0);
+    }
+
     #[test]
     fn a_give_way_tow_acts_by_the_cpa_when_the_target_closes_fast() {
         let tow = tow_at(Pose::new(2.0, 0.0, 0.0), 0.1);
