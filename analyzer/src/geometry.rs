@@ -8,7 +8,7 @@ use std::f64::consts::PI;
 
 pub use towing_model::geometry::{
     abaft_and_opening, body_to_ned, crossed_ahead, dist, drawing_away, line_coordinates,
-    segment_projection, HullRect, Lane, Polyline, Projection,
+    segment_projection, starboard_offset, HullRect, Lane, Polyline, Projection,
 };
 
 /// A point `[north, east]`, m.
@@ -83,9 +83,11 @@ impl RouteCourse {
         else {
             return 0.0;
         };
-        let at = route.project(p);
-        let n = route.starboard_normal(at.segment);
-        (p[0] - at.point[0]) * n[0] + (p[1] - at.point[1]) * n[1]
+        let (k, w) = (route.project(p).segment, route.points());
+        match (w.get(k), w.get(k + 1)) {
+            (Some(&a), Some(&b)) => starboard_offset(a, b, p).map_or(0.0, |(offset, _)| offset),
+            _ => 0.0,
+        }
     }
 }
 

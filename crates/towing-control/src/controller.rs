@@ -37,7 +37,7 @@ use towing_guidance::{
     body_to_ned, role, segment_distance, ActiveObstacle, GuidanceOutput, GuidanceParams,
     ReferenceSystem, Role, Situation, TowState,
 };
-use towing_model::geometry::{abaft_and_opening, Lane};
+use towing_model::geometry::{abaft_and_opening, starboard_offset, Lane};
 use towing_model::{
     wrap_angle, ObstacleKind, ObstacleSlot, Pose, VesselData, VesselState, World, MAX_OBSTACLES,
 };
@@ -1362,12 +1362,10 @@ impl Controller {
 /// `docs/colregs.md` section 2, step 7).
 fn lift_to_offset(goal: [f64; 3], leg: ([f64; 2], [f64; 2]), offset: f64) -> [f64; 3] {
     let (a, b) = leg;
-    let r = (b[0] - a[0]).hypot(b[1] - a[1]);
-    if offset <= 0.0 || r <= 0.0 {
+    let Some((across, n)) = starboard_offset(a, b, [goal[0], goal[1]]).filter(|_| offset > 0.0)
+    else {
         return goal;
-    }
-    let n = [-(b[1] - a[1]) / r, (b[0] - a[0]) / r];
-    let across = (goal[0] - a[0]) * n[0] + (goal[1] - a[1]) * n[1];
+    };
     let lift = (offset - across).max(0.0);
     [goal[0] + lift * n[0], goal[1] + lift * n[1], goal[2]]
 }

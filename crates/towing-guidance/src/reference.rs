@@ -52,6 +52,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use towing_model::geometry::starboard_offset;
 use towing_model::{ObstacleKind, ObstacleSlot, Pose, MAX_OBSTACLES};
 
 use crate::colregs::{action, classify, safe_reading, Action, Encounter, Manoeuvre, Situation};
@@ -836,10 +837,9 @@ impl ReferenceSystem {
     /// `[0, inf)` without one.
     fn offset_to_starboard(&self, ship: [f64; 2], p: usize) -> f64 {
         let points = self.route.points();
-        let (a, b) = (points[p - 1], points[p]);
+        let (a, b) = (points[p - 1].position(), points[p].position());
+        let offset = starboard_offset(a, b, ship).map_or(0.0, |(offset, _)| offset);
         let r = self.route.segment_length(p);
-        let n = [-(b.y - a.y) / r, (b.x - a.x) / r];
-        let offset = (ship[0] - a.x) * n[0] + (ship[1] - a.y) * n[1];
         let bound = match self.params.settings().waterway_half_width {
             Some(d2) => r * theta_max(r, d2).sin(),
             None => f64::INFINITY,

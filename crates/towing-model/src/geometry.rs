@@ -35,6 +35,20 @@ pub fn line_coordinates(origin: Point, course: f64, p: Point) -> (f64, f64) {
     (dn * c + de * s, -dn * s + de * c)
 }
 
+/// How far `p` lies to starboard of the line from `a` through `b` (m, negative to port),
+/// with the line's unit starboard normal; `None` when `a` and `b` coincide. The
+/// guidance's offset held while altered, the controller's lift of the tracked point to
+/// it and the analyzer's offset from the route all measure it so.
+#[must_use]
+pub fn starboard_offset(a: Point, b: Point, p: Point) -> Option<(f64, Point)> {
+    let r = (b[0] - a[0]).hypot(b[1] - a[1]);
+    if r.is_nan() || r <= 0.0 {
+        return None;
+    }
+    let n = [-(b[1] - a[1]) / r, (b[0] - a[0]) / r];
+    Some(((p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1], n))
+}
+
 /// Own ship's heading line and a target at one sample: own position, own heading (rad from
 /// North, clockwise), the target's position.
 pub type LineSighting = (Point, f64, Point);
@@ -472,6 +486,19 @@ mod tests {
         };
         let steps = (60.0 / dt).round() as usize;
         (1..=steps).any(|k| crossed_ahead(at((k - 1) as f64 * dt), at(k as f64 * dt)))
+    }
+
+    #[test]
+    fn starboard_offset_is_the_signed_distance_from_the_line() {
+        // A northbound line: East is starboard.
+        let (offset, n) = starboard_offset([0.0, 0.0], [10.0, 0.0], [4.0, 1.5]).unwrap();
+        assert_eq!((offset, n), (1.5, [0.0, 1.0]));
+        // Eastbound: South is starboard; the same as the across coordinate of
+        // `line_coordinates`.
+        let (offset, _) = starboard_offset([0.0, 0.0], [0.0, 5.0], [2.0, 7.0]).unwrap();
+        assert!((offset - -2.0).abs() < 1e-15);
+        assert!((line_coordinates([0.0, 0.0], PI / 2.0, [2.0, 7.0]).1 - offset).abs() < 1e-15);
+        assert_eq!(starboard_offset([1.0, 1.0], [1.0, 1.0], [0.0, 0.0]), None);
     }
 
     #[test]
