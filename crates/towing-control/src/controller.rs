@@ -1358,7 +1358,7 @@ impl Controller {
 /// of an alteration never lies to port of the track the tow has reached: past each
 /// waypoint the altered leg starts on the route again, and its point lay up to 14 deg
 /// to port of the route for a tow already 1.6-3.2 m to starboard of it, which turned
-/// her back towards the vessel she was overtaking (random-12-0067, 0069, 0147,
+/// her back towards the vessel she was overtaking (random-12-0067,
 /// `docs/colregs.md` section 2, step 7).
 fn lift_to_offset(goal: [f64; 3], leg: ([f64; 2], [f64; 2]), offset: f64) -> [f64; 3] {
     let (a, b) = leg;
