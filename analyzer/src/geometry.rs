@@ -8,7 +8,7 @@ use std::f64::consts::PI;
 
 pub use towing_model::geometry::{
     abaft_and_opening, body_to_ned, crossed_ahead, dist, drawing_away, line_coordinates,
-    segment_projection, starboard_offset, HullRect, Lane, Polyline, Projection,
+    segment_projection, HullRect, Lane, Polyline, Projection,
 };
 
 /// A point `[north, east]`, m.
@@ -71,24 +71,34 @@ impl RouteCourse {
             .unwrap_or(0.0)
     }
 
-    /// How far `p` lies to starboard of the route (m, negative to port): its distance
-    /// from its nearest point on the route, signed by that segment's starboard normal; 0
-    /// without a route or at a non-finite `p`.
+    /// The route's course at `p` ([`RouteCourse::at`]) and how far `p` lies to starboard
+    /// of the route (m, negative to port: its distance from the segment of its nearest
+    /// point on the route, signed), from one projection; both 0 without a route or at a
+    /// non-finite `p`.
     #[must_use]
-    pub fn cross_track(&self, p: P2) -> f64 {
+    pub fn track(&self, p: P2) -> Track {
         let Some(route) = self
             .route
             .as_ref()
             .filter(|_| p[0].is_finite() && p[1].is_finite())
         else {
-            return 0.0;
+            return Track::default();
         };
-        let (k, w) = (route.project(p).segment, route.points());
-        match (w.get(k), w.get(k + 1)) {
-            (Some(&a), Some(&b)) => starboard_offset(a, b, p).map_or(0.0, |(offset, _)| offset),
-            _ => 0.0,
+        let at = route.project(p);
+        Track {
+            course: route.course_from(at.s, self.lookahead).unwrap_or(0.0),
+            cross_track: route.offset_from(&at, p),
         }
     }
+}
+
+/// The ship against her route at a step ([`RouteCourse::track`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Track {
+    /// The route's course, rad.
+    pub course: f64,
+    /// The offset to starboard of the route, m.
+    pub cross_track: f64,
 }
 
 /// Wraps an angle to `(-pi, pi]`.

@@ -74,8 +74,9 @@ use crate::error::Result;
 
 use crate::colregs::{classify, Situation};
 use crate::geometry::{
-    abaft_and_opening, course_velocity, cpa_tcpa, crossed_ahead, dist, drawing_away,
-    course_line_crossing, hull_ellipse_clearance, line_coordinates, relative_bearing, wrap, RouteCourse,
+    abaft_and_opening, course_line_crossing, course_velocity, cpa_tcpa, crossed_ahead, dist,
+    drawing_away, hull_ellipse_clearance, line_coordinates, relative_bearing, wrap, RouteCourse,
+    Track,
 };
 use crate::rows::VESSELS;
 use crate::step::{Obstacle, ObstacleKind, PlantStep, RunGeometry, Vessel};
@@ -199,7 +200,7 @@ struct Detection {
     /// The ship's heading less the route's course ([`RouteCourse`]), rad: course changes
     /// are measured from it.
     off_course: f64,
-    /// The ship's offset to starboard of her route ([`RouteCourse::cross_track`]), m:
+    /// The ship's offset to starboard of her route ([`RouteCourse::track`]), m:
     /// the offset an alteration gains is measured from it.
     cross_track: f64,
     sog: f64,
@@ -240,15 +241,6 @@ struct Target {
 
 /// Own vessels with the sizes, as the checks need them.
 type Tow<'s> = (&'s [Vessel; 3], &'s [[f64; 2]; 3]);
-
-/// The ship against her route at a step ([`RouteCourse`]).
-#[derive(Debug, Clone, Copy)]
-struct Track {
-    /// The route's course, rad.
-    course: f64,
-    /// The ship's offset to starboard of the route, m.
-    cross_track: f64,
-}
 
 /// The target's side of the ship's heading line and its own velocity across that line
 /// (both + starboard): it draws away from the line when their product is positive.
@@ -728,10 +720,7 @@ impl RulesTracker {
             t.excused_by = if first == Some(k) { second } else { first };
         }
         let ship = step.vessels[0];
-        let track = Track {
-            course: self.course.at([ship.x, ship.y]),
-            cross_track: self.course.cross_track([ship.x, ship.y]),
-        };
+        let track = self.course.track([ship.x, ship.y]);
         for o in step
             .obstacles
             .iter()

@@ -331,11 +331,16 @@ impl Polyline {
     /// Lameijer, *A Guide to the Collision Avoidance Rules*, on Rule 17).
     #[must_use]
     pub fn course_ahead(&self, p: Point, lookahead: f64) -> Option<f64> {
+        self.course_from(self.project(p).s, lookahead)
+    }
+
+    /// [`Polyline::course_ahead`] from the arc length `here` of a point's projection.
+    #[must_use]
+    pub fn course_from(&self, here: f64, lookahead: f64) -> Option<f64> {
         let length = self.length();
         if length.is_nan() || length <= 0.0 {
             return None;
         }
-        let here = self.project(p).s;
         let (from, to) = if here + 1e-9 < length {
             (
                 self.point_at(here),
@@ -361,17 +366,24 @@ impl Polyline {
     /// polyline.
     #[must_use]
     pub fn starboard_normal(&self, k: usize) -> Point {
+        self.segment_offset(k, [0.0, 0.0])
+            .map_or([0.0, 1.0], |(_, n)| n)
+    }
+
+    /// How far `p` lies to starboard of the projection `at`'s segment ([`starboard_offset`]);
+    /// 0 for a zero-length segment or a one-point polyline.
+    #[must_use]
+    pub fn offset_from(&self, at: &Projection, p: Point) -> f64 {
+        self.segment_offset(at.segment, p)
+            .map_or(0.0, |(offset, _)| offset)
+    }
+
+    /// [`starboard_offset`] of `p` from segment `k`; `None` for a zero-length segment or
+    /// none.
+    fn segment_offset(&self, k: usize, p: Point) -> Option<(f64, Point)> {
         match (self.points.get(k), self.points.get(k + 1)) {
-            (Some(a), Some(b)) => {
-                let (dn, de) = (b[0] - a[0], b[1] - a[1]);
-                let l = dn.hypot(de);
-                if l > 0.0 {
-                    [-de / l, dn / l]
-                } else {
-                    [0.0, 1.0]
-                }
-            }
-            _ => [0.0, 1.0],
+            (Some(&a), Some(&b)) => starboard_offset(a, b, p),
+            _ => None,
         }
     }
 }
