@@ -213,8 +213,9 @@ pub struct TrackingParams {
     /// Port-turn margin (rad) of the heading floor: while an encounter in which
     /// the tow may not turn to port is under way (head-on, Rule 14; crossing,
     /// Rules 15 and 17(c)) and the scheme alters waypoints (I, II), the ship's
-    /// predicted heading is kept to starboard of its heading at the start of
-    /// the encounter minus this margin
+    /// predicted heading is kept to starboard of the route's course plus her
+    /// heading off it at the start of the encounter (ratcheted to starboard,
+    /// `Controller::heading_floor`) minus this margin
     /// ([`towing_mpc::ShipMpcParams::weight_port_turn`]).
     pub port_turn_margin: f64,
     /// Largest rate (rad/s) at which the reference course turns

@@ -37,7 +37,7 @@ use towing_guidance::{
     body_to_ned, role, segment_distance, ActiveObstacle, GuidanceOutput, GuidanceParams,
     ReferenceSystem, Role, Situation, TowState,
 };
-use towing_model::geometry::{abaft_and_opening, starboard_offset, Lane};
+use towing_model::geometry::{abaft_and_opening, starboard_offset, Lane, Polyline};
 use towing_model::{
     wrap_angle, ObstacleKind, ObstacleSlot, Pose, VesselData, VesselState, World, MAX_OBSTACLES,
 };
@@ -319,8 +319,9 @@ struct Carried {
     nu_start: [[f64; 3]; 2],
     nu_end: [[f64; 3]; 2],
     fallbacks: u64,
-    /// Per obstacle slot: the highest heading reached since an encounter began in
-    /// which the tow may not turn to port ([`TrackingParams::port_turn_margin`]).
+    /// Per obstacle slot: the most starboard heading off the route's course
+    /// ([`Controller::route_course`]) reached since an encounter began in which the
+    /// tow may not turn to port ([`TrackingParams::port_turn_margin`]), rad.
     port_turn_anchor: [Option<f64>; MAX_OBSTACLES],
     /// The obstacle slot of the crossing for which the tow gives way whose altered course
     /// ran out of water ([`Controller::short_of_water`]): she keeps the way off until
@@ -387,6 +388,9 @@ pub struct Controller {
     mpc_obstacles: [Obstacle; MAX_OBSTACLES],
     /// The waterway of the MPC ([`ControllerConfig::waterway`]).
     waterway: Option<(Lane, [f64; 3])>,
+    /// The scenario's route as a line, for the course of following it
+    /// ([`Controller::route_course`]).
+    route: Polyline,
     /// A copy of the last sample's MPC input ([`Controller::last_mpc_input`]).
     last_input: Option<MpcInput>,
 }
@@ -432,8 +436,10 @@ impl Controller {
         let f0 = config.tuning.ship.min_tension;
         let sample_time = config.tuning.prediction.sample_time;
         let waterway = config.waterway();
+        let route = Polyline::of_route(&config.scenario.route);
         Ok(Controller {
             waterway,
+            route,
             config,
             guidance,
             solver,
@@ -679,7 +685,7 @@ impl Controller {
             t.tracking.lookahead
         };
         let status = t.guidance.colregs.tow_status;
-        let heading_floor = self.heading_floor(m);
+        let heading_floor = self.heading_floor(m, altered);
         let reference = self.reference(
             m,
             (guidance.active_waypoint, target, guidance.offset_held),
@@ -1101,9 +1107,12 @@ impl Controller {
     /// COLREGS: in a head-on situation (Rule 14) and a crossing in which the tow
     /// gives way (Rule 15) the tow alters to starboard; in a crossing in which
     /// it stands on it must not turn to port for the vessel on its port side
-    /// (Rule 17(c)). In all three the tow therefore never turns to port: the
-    /// highest heading reached since the encounter began, less
-    /// [`TrackingParams::port_turn_margin`], is a floor for the ship's predicted
+    /// (Rule 17(c)). In all three the tow therefore never turns to port off the
+    /// course of her route ([`Controller::route_course`]: rounding a bend of the
+    /// route is keeping her course, Rule 17(a)(i), as the analyzer judges it): the
+    /// most starboard heading off the route's course reached since the encounter
+    /// began, less [`TrackingParams::port_turn_margin`], laid off from the route's
+    /// course of the sample, is a floor for the ship's predicted
     /// headings until the target is past and clear (Rule 8(d); the guidance's
     /// test) or the encounter ends: an alteration is not taken back, and a swing
     /// past the intended course is not taken back either while the target is not
@@ -1124,12 +1133,15 @@ impl Controller {
     /// target by its distance terms, swung the ship's head up to 15 deg towards
     /// it at close quarters. Scheme III (distance cost only, no COLREGS logic)
     /// has no floor, as in the paper.
-    fn heading_floor(&mut self, m: &Measurement) -> Option<f64> {
+    fn heading_floor(&mut self, m: &Measurement, altered: bool) -> Option<f64> {
         let psi = m.ship[2];
+        // The heading off the route's course, + to starboard.
+        let off = wrap_angle(psi - self.route_course(m));
         let alters = self.config.tuning.scheme.alters();
         let mut floor: Option<f64> = None;
         for k in 0..MAX_OBSTACLES {
-            let no_port_turn = match self.guidance.situation(k) {
+            let situation = self.guidance.situation(k);
+            let no_port_turn = match situation {
                 Some(
                     Situation::HeadOn | Situation::CrossingGiveWay | Situation::CrossingStandOn,
                 ) => true,
@@ -1145,17 +1157,36 @@ impl Controller {
                 continue;
             }
             // Ratchet: a starboard alteration is not taken back before the
-            // situation ends (Rule 8(d): until the target is past and clear).
+            // situation ends (Rule 8(d): until the target is past and clear). A tow
+            // that stands on and has not altered keeps the course she had (Rule
+            // 17(a)(i)): no ratchet, since her head lagging behind a port bend of
+            // the route is no alteration to hold.
+            let stands_on = matches!(
+                situation,
+                Some(Situation::CrossingStandOn | Situation::BeingOvertaken)
+            );
             let anchor = match self.carried.port_turn_anchor[k] {
-                Some(a) if wrap_angle(a - psi) > 0.0 => a,
-                _ => psi,
+                Some(a) if a > off || (stands_on && !altered) => a,
+                _ => off,
             };
             self.carried.port_turn_anchor[k] = Some(anchor);
             // Relative to the current heading, so that wrapping cannot matter.
-            let limit = wrap_angle(anchor - psi) - self.config.tuning.tracking.port_turn_margin;
+            let limit = anchor - off - self.config.tuning.tracking.port_turn_margin;
             floor = Some(floor.map_or(limit, |f: f64| f.max(limit)));
         }
         floor.map(|f| psi + f)
+    }
+
+    /// The course of following the route from where the ship is (rad): the bearing of
+    /// the point [`TrackingParams::lookahead`] farther along the route from her nearest
+    /// point on it ([`Polyline::course_ahead`], the course the analyzer measures course
+    /// changes against, `docs/analyzer.md`, "Course changes"); 0 for a route without
+    /// length.
+    fn route_course(&self, m: &Measurement) -> f64 {
+        let lookahead = self.config.tuning.tracking.lookahead;
+        (self.route)
+            .course_ahead([m.ship[0], m.ship[1]], lookahead)
+            .unwrap_or(0.0)
     }
 
     /// Whether the tow gives way to the crossing target in slot `giving_way_to` with her

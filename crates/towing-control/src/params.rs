@@ -286,6 +286,18 @@ pub static PARAMETERS: &[Parameter] = &[
         },
     },
     Parameter {
+        name: "mpc.ship.holding_tension",
+        old_name: None,
+        description: "While the way is off (the ship's plan capped in surge: Rule 17's way off, the give-way way off) the smallest tension of each line instead of mpc.ship.min_tension, reached from the previous command within the rate bound mpc.ship.tension_rate, so the tugs' sideways pull F sin(alpha) can turn and hold the stopped ship; at most mpc.ship.min_tension: no effect; 0.3 N (docs/assumptions.md)",
+        kind: Kind::Real {
+            unit: "N",
+            min: Limit::AtLeast(0.0),
+            max: Limit::None,
+            get: |t| t.ship.holding_tension,
+            set: |t, v| t.ship.holding_tension = v,
+        },
+    },
+    Parameter {
         name: "mpc.ship.max_tension",
         old_name: Some("max_tension"),
         description: "Largest towline tension F_max, eq. (18); 3 N as Table 3",
@@ -700,7 +712,7 @@ pub static PARAMETERS: &[Parameter] = &[
     Parameter {
         name: "tracking.port_turn_margin",
         old_name: Some("port_turn_margin"),
-        description: "While a head-on or crossing encounter lasts (schemes I, II), the ship's predicted heading stays to starboard of the highest heading reached since it began, less this margin (the reference course too) (COLREGS Rules 8(d), 14, 15, 17(c): no turn to port); 2 deg (docs/assumptions.md)",
+        description: "While a head-on or crossing encounter lasts (schemes I, II), the ship's predicted heading stays to starboard of the route's course plus the most starboard heading off it reached since the encounter began (the heading off it at the start for a stand-on tow that has not altered), less this margin (the reference course too) (COLREGS Rules 8(d), 14, 15, 17(c): no turn to port; following the route's bends is keeping course); 2 deg (docs/assumptions.md)",
         kind: Kind::Real {
             unit: "rad",
             min: Limit::AtLeast(0.0),

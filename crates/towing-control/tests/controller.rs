@@ -570,7 +570,8 @@ fn giving_way_with_the_altered_course_out_of_water_keeps_the_way_off() {
 /// 9 m off on the port side (beyond d_D) and 54 s from the CPA: the stand-on tow keeps
 /// the route and takes the way off, the plan's surge capped at the measured surge less
 /// `guidance.rule17_way_off_deceleration` T_s, and at `guidance.rule17_way_off_speed`
-/// once she is slower. Scheme III (no COLREGS logic) has no cap.
+/// once she is slower, with both lines at the holding tension
+/// (`mpc.ship.holding_tension`). Scheme III (no COLREGS logic) has no cap.
 #[test]
 fn a_stand_on_tow_takes_the_way_off_under_rule_17() {
     let (scenario, mut m) = paper_measurement();
@@ -605,6 +606,12 @@ fn a_stand_on_tow_takes_the_way_off_under_rule_17() {
             (got - expected).abs() < 1e-12,
             "surge {u}: cap {got}, expected {expected}"
         );
+        // Both lines at least at the holding tension (from the 0.1 N pretension,
+        // within one sample's rate bound), so the tugs can hold her head.
+        let hold = config.tuning.ship.holding_tension;
+        for (i, f) in r.command.tension.iter().enumerate() {
+            assert!(*f >= hold - 1e-9, "surge {u}: line {i} at {f} N");
+        }
     }
     let mut config = config;
     config.tuning.scheme = AvoidanceScheme::CostOnly;
@@ -719,6 +726,58 @@ fn a_crossing_encounter_sets_a_heading_floor_that_ratchets_and_lifts() {
     // Scheme III: no COLREGS logic, no floor.
     let mut three = controller(AvoidanceScheme::CostOnly);
     assert_eq!(three.sample(&m).unwrap().heading_floor, None);
+}
+
+/// The heading floor is laid off from the route's course (Rule 17's "course" is that of
+/// the manoeuvre, `docs/analyzer.md`, "Course changes"): the tow giving way on the
+/// paper's first leg, carried unchanged to just short of the route's starboard bend at
+/// (-10.7, 36), has the floor turned with the route's course there, the bearing from her
+/// nearest point on the route to the point `tracking.lookahead` farther along it.
+#[test]
+fn the_heading_floor_turns_with_a_bend_of_the_route() {
+    let (scenario, mut m) = paper_measurement();
+    let psi = m.ship[2];
+    m.obstacles[3] = crossing_from_starboard(&m);
+    let config = ControllerConfig::new(scenario.clone());
+    let margin = config.tuning.tracking.port_turn_margin;
+    let lookahead = config.tuning.tracking.lookahead;
+    let route = towing_model::geometry::Polyline::of_route(&scenario.route);
+    let course = |m: &Measurement| {
+        route
+            .course_ahead([m.ship[0], m.ship[1]], lookahead)
+            .unwrap()
+    };
+    let mut c = Controller::new(config).unwrap();
+    let r = c.sample(&m).unwrap();
+    assert_eq!(r.role[3], Some(Role::GiveWay));
+    let off = towing_model::wrap_angle(psi - course(&m));
+    let floor = r.heading_floor.expect("a floor while giving way");
+    assert!((floor - (psi - margin)).abs() < 1e-12, "{floor} vs {psi}");
+
+    // The whole encounter moved, unturned, to 0.5 m short of the bend on the first leg.
+    let along = [
+        -10.7 + 0.5 * 1.6 / 8.0f64.hypot(1.6),
+        36.0 - 0.5 * 8.0 / 8.0f64.hypot(1.6),
+    ];
+    let shift = [along[0] - m.ship[0], along[1] - m.ship[1]];
+    let mut moved = m;
+    let [tug1, tug2] = &mut moved.tugs;
+    for p in [&mut moved.ship, tug1, tug2] {
+        p[0] += shift[0];
+        p[1] += shift[1];
+    }
+    moved.obstacles[3].x += shift[0];
+    moved.obstacles[3].y += shift[1];
+    let bend = towing_model::wrap_angle(course(&moved) - course(&m));
+    assert!(bend > 20f64.to_radians(), "the route turns ahead: {bend}");
+    let r = c.sample(&moved).unwrap();
+    let floor = r.heading_floor.expect("still giving way");
+    let expected = course(&moved) + off - margin;
+    assert!(
+        towing_model::wrap_angle(floor - expected).abs() < 1e-9,
+        "floor {floor} vs the route's course {} off {off}",
+        course(&moved)
+    );
 }
 
 /// The controller's own clock: a sample at the first step and every T_s after

@@ -703,6 +703,12 @@ impl Subproblem for CentralProblem {
         &self.space
     }
 
+    fn prepare(&mut self, data: &CentralData<'_>) {
+        let sample_time = self.ship.params().sample_time;
+        let (way_off, previous) = (data.input.max_surge.is_some(), &data.input.previous.ship);
+        (self.ship_params).floor_tensions(&mut self.space, way_off, previous, sample_time);
+    }
+
     fn rows(&self) -> CentralRows {
         // Row m = cons_index(i, h, c): sample h, about tug i and the ship.
         let rows = (0..NC)

@@ -92,6 +92,15 @@ pub struct ShipMpcParams {
     /// picks the least tension among plans of (nearly) equal cost. 0 reproduces
     /// eq. (13) as printed.
     pub weight_tension: f64,
+    /// `F_hold` (N): while the way is off (the plan's surge capped,
+    /// [`crate::SampleInput::max_surge`]) the smallest tension of each line is `F_hold`
+    /// instead of `F_min`, reached within the rate bound
+    /// ([`ShipMpcParams::tension_floor`]). A stopped ship is turned and held by the tugs'
+    /// sideways pull `F sin alpha`; with the lines at `F_min` that pull barely changes
+    /// with the towing angle to first order, and the SCP step left the stopped ship
+    /// yawing off her course (`docs/controller-design.md`, "Standing on"). Tugs holding
+    /// a ship stopped keep their lines tight. At most `F_min`: `F_min` always.
+    pub holding_tension: f64,
     /// Optional terminal term, not in the paper (`docs/assumptions.md`).
     pub terminal: Option<TerminalCost>,
     /// Trust-region scale of `(F, alpha)` (N, rad): the box is `radius * scale`.
@@ -132,6 +141,7 @@ impl Default for ShipMpcParams {
             angle_rate: 5f64.to_radians(),
             weight_towing_angle: 0.0,
             weight_tension: 0.01,
+            holding_tension: 0.3,
             terminal: Some(TerminalCost {
                 weight: 1.0,
                 horizon: 10.0,
@@ -193,6 +203,37 @@ impl ShipMpcParams {
                 self.max_angle,
                 self.angle_rate * sample_time,
             )
+        }
+    }
+
+    /// The smallest tension (N) of a line whose previous command was `previous` (N),
+    /// for samples of `sample_time` s: `F_min`, or while the way is off (`way_off`)
+    /// `F_hold`, no more above the previous command than one sample's rate bound
+    /// allows (so the floor never makes the first sample infeasible).
+    #[must_use]
+    pub fn tension_floor(&self, way_off: bool, previous: f64, sample_time: f64) -> f64 {
+        if !way_off {
+            return self.min_tension;
+        }
+        let reach = previous.max(self.min_tension) + self.tension_rate * sample_time;
+        self.holding_tension
+            .min(reach)
+            .min(self.max_tension)
+            .max(self.min_tension)
+    }
+
+    /// Sets the lower bounds of the tension channels 0 and 1 of `space` to their
+    /// [`ShipMpcParams::tension_floor`] from the `previous` command (its first two
+    /// entries, the tensions).
+    pub fn floor_tensions(
+        &self,
+        space: &mut InputSpace,
+        way_off: bool,
+        previous: &[f64],
+        sample_time: f64,
+    ) {
+        for k in 0..2 {
+            space.set_lower(k, self.tension_floor(way_off, previous[k], sample_time));
         }
     }
 
@@ -346,6 +387,12 @@ impl Subproblem for ShipProblem {
 
     fn space(&self) -> &InputSpace {
         &self.space
+    }
+
+    fn prepare(&mut self, data: &ShipStepData<'_>) {
+        let sample_time = self.model.params().sample_time;
+        let way_off = data.max_surge.is_some();
+        (self.params).floor_tensions(&mut self.space, way_off, &data.previous, sample_time);
     }
 
     fn rows(&self) -> ShipRows {
@@ -549,6 +596,30 @@ mod tests {
 
     fn ship_mpc() -> ShipMpc {
         ship_mpc_with(ShipMpcParams::default())
+    }
+
+    /// The holding tension is the floor only while the way is off, reached within one
+    /// sample's rate bound from the previous command, never below `F_min` nor above
+    /// `F_max`.
+    #[test]
+    fn the_holding_tension_is_the_floor_while_the_way_is_off() {
+        let p = ShipMpcParams::default();
+        assert!(p.holding_tension > p.min_tension);
+        assert_eq!(p.tension_floor(false, 0.1, 1.0), p.min_tension);
+        assert_eq!(p.tension_floor(true, 0.1, 1.0), p.holding_tension);
+        // One sample of 0.1 s raises it by tension_rate * 0.1 only.
+        let reach = p.min_tension + p.tension_rate * 0.1;
+        assert!((p.tension_floor(true, 0.0, 0.1) - reach).abs() < 1e-12);
+        let low = ShipMpcParams {
+            holding_tension: 0.0,
+            ..p
+        };
+        assert_eq!(low.tension_floor(true, 0.1, 1.0), p.min_tension);
+        let high = ShipMpcParams {
+            holding_tension: 10.0,
+            ..p
+        };
+        assert_eq!(high.tension_floor(true, 2.9, 1.0), p.max_tension);
     }
 
     fn ship_mpc_with(params: ShipMpcParams) -> ShipMpc {

@@ -176,6 +176,9 @@ pub trait Subproblem: Debug {
 
     /// The decision variables.
     fn space(&self) -> &InputSpace;
+    /// Sets what the decision variables' bounds take from this step's data (before
+    /// the step reads [`Subproblem::space`]); by default nothing does.
+    fn prepare(&mut self, _data: &Self::Data<'_>) {}
     /// The soft rows, sized for the largest layout.
     fn rows(&self) -> Self::Rows;
     /// An empty trajectory and linearisation (buffers).
@@ -402,6 +405,7 @@ impl<P: Subproblem> Scp<P> {
     /// One SCP step (module docs). Allocation-free once its QP layout exists (a
     /// combination of soft rows met for the first time builds one).
     pub fn step(&mut self, data: &P::Data<'_>) -> ScpReport {
+        self.problem.prepare(data);
         let space = self.problem.space();
         let n_u = space.len();
         self.problem.previous(data, &mut self.previous);

@@ -60,6 +60,16 @@ impl Channel {
     pub fn is_rated(&self) -> bool {
         self.rate.is_finite()
     }
+
+    /// What the first sample's rate band is measured from: the previous command,
+    /// brought to within one rate bound of the bounds (a previous command outside
+    /// them, after a bound moved, [`InputSpace::set_lower`]): the band then always
+    /// meets the bounds, and a bound within one rate bound of the previous command
+    /// is reached without exceeding the rate.
+    #[must_use]
+    pub fn start(&self, previous: f64) -> f64 {
+        previous.clamp(self.lower - self.rate, self.upper + self.rate)
+    }
 }
 
 /// The channels of one sample over a horizon (module docs).
@@ -131,6 +141,12 @@ impl InputSpace {
         self.channels[i % ps].moves & self.channels[j % ps].moves != 0
     }
 
+    /// Sets the lower bound of channel `k` to `lower` (at most its upper bound).
+    pub fn set_lower(&mut self, k: usize, lower: f64) {
+        let c = &mut self.channels[k];
+        c.lower = lower.min(c.upper);
+    }
+
     /// Flat index of channel `k` of sample `h`.
     #[must_use]
     pub fn index(&self, h: usize, k: usize) -> usize {
@@ -138,12 +154,12 @@ impl InputSpace {
     }
 
     /// Projects `plan` onto the bounds and rate bounds, sample by sample, the
-    /// first sample measured from `previous` (itself clamped into the bounds):
+    /// first sample measured from `previous` ([`Channel::start`]):
     /// afterwards `du = 0` is feasible for the step's QP. Channels without a rate
     /// bound are clamped into their bounds.
     pub fn project(&self, plan: &mut [f64], previous: &[f64]) {
         for (k, c) in self.channels.iter().enumerate() {
-            let mut before = previous[k].clamp(c.lower, c.upper);
+            let mut before = c.start(previous[k]);
             for h in 0..self.horizon {
                 let u = &mut plan[self.index(h, k)];
                 *u = u.clamp(c.lower.max(before - c.rate), c.upper.min(before + c.rate));
@@ -166,7 +182,7 @@ impl InputSpace {
     ) {
         for (k, c) in self.channels.iter().enumerate() {
             let tr = radius * c.trust_scale;
-            let prev = previous[k].clamp(c.lower, c.upper);
+            let prev = c.start(previous[k]);
             for h in 0..self.horizon {
                 let j = self.index(h, k);
                 let u = plan[j];
@@ -234,11 +250,11 @@ impl InputSpace {
     }
 
     /// Whether `plan` satisfies every bound and rate bound (the first sample
-    /// from `previous`, clamped into the bounds) within `tol`.
+    /// from `previous`, [`Channel::start`]) within `tol`.
     #[must_use]
     pub fn contains(&self, plan: &[f64], previous: &[f64], tol: f64) -> bool {
         self.channels.iter().enumerate().all(|(k, c)| {
-            let mut before = previous[k].clamp(c.lower, c.upper);
+            let mut before = c.start(previous[k]);
             (0..self.horizon).all(|h| {
                 let u = plan[self.index(h, k)];
                 let ok =
@@ -308,6 +324,29 @@ mod tests {
                 prop_assert!(q[j] <= s.channels()[j % 2].upper + 1e-12);
             }
         }
+    }
+
+    /// A lower bound raised above the previous command (the ship's holding tension,
+    /// `ShipMpcParams::tension_floor`) is met by the first sample without a change
+    /// beyond the rate bound when it lies within one rate bound; beyond that reach the
+    /// plan is still feasible, measured from the previous command brought within reach.
+    #[test]
+    fn a_raised_lower_bound_is_reached_within_the_rate() {
+        let mut s = space();
+        s.set_lower(0, 0.3);
+        let previous = [0.1, 0.0];
+        let mut plan = vec![0.0; 6];
+        s.project(&mut plan, &previous);
+        assert!(
+            plan[0] >= 0.3 && plan[0] - previous[0] <= 0.3 + 1e-12,
+            "{plan:?}"
+        );
+        assert!(s.contains(&plan, &previous, 1e-12));
+        s.set_lower(0, 1.0);
+        let mut plan = vec![0.0; 6];
+        s.project(&mut plan, &previous);
+        assert!((plan[0] - 1.0).abs() < 1e-12, "{plan:?}");
+        assert!(s.contains(&plan, &previous, 1e-12));
     }
 
     #[test]
