@@ -1381,8 +1381,6 @@ impl Controller {
     }
 }
 
-/// The angle `to`, or the one at most `max` (rad, > 0) from `from` towards it, wrapped to
-/// `(-pi, pi]`.
 /// `goal` moved square to the segment `leg` to `offset` m to its starboard side if it
 /// lies nearer the route than that (the offset the tow has gained while altered,
 /// [`towing_guidance::GuidanceOutput::offset_held`]); else `goal`. The tracked point
@@ -1401,6 +1399,8 @@ fn lift_to_offset(goal: [f64; 3], leg: ([f64; 2], [f64; 2]), offset: f64) -> [f6
     [goal[0] + lift * n[0], goal[1] + lift * n[1], goal[2]]
 }
 
+/// The angle `to`, or the one at most `max` (rad, > 0) from `from` towards it, wrapped to
+/// `(-pi, pi]`.
 fn turn_towards(from: f64, to: f64, max: f64) -> f64 {
     wrap_angle(from + wrap_angle(to - from).clamp(-max, max))
 }

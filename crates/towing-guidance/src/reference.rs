@@ -1068,11 +1068,15 @@ impl ReferenceSystem {
         }
         // Step 7: the offset gained while altered is held (of the new segment's line
         // once the active waypoint advances).
-        let offset = self.offset_to_starboard(ship, self.active);
-        self.offset_held = match (altered, self.active == before) {
-            (false, _) => 0.0,
-            (true, true) => self.offset_held.max(offset),
-            (true, false) => offset,
+        self.offset_held = if altered {
+            let offset = self.offset_to_starboard(ship, self.active);
+            if self.active == before {
+                self.offset_held.max(offset)
+            } else {
+                offset
+            }
+        } else {
+            0.0
         };
         Ok(GuidanceOutput {
             eta_sd: target,
@@ -1231,10 +1235,6 @@ mod tests {
         assert_eq!(out.governing.unwrap().manoeuvre, Manoeuvre::FollowRoute);
     }
 
-    /// Rule 16 with 17(a)(ii): a give-way tow acts no later than her failure to act
-    /// would let the stand-on vessel act (closing, TCPA <= 55 s, DCPA < 2.5 m), even
-    /// with the target still beyond d_D; the encounter is then held as one detected
-    /// within it. A target passing wide is no risk and gets no action beyond d_D.
     #[test]
     fn the_offset_gained_while_altered_is_held_and_bounded_by_the_waterway() {
         // A straight northbound route with a waypoint every 6 m (as the random
@@ -1274,6 +1274,10 @@ mod tests {
         assert!(!out.altered && out.offset_held == 0.0);
     }
 
+    /// Rule 16 with 17(a)(ii): a give-way tow acts no later than her failure to act
+    /// would let the stand-on vessel act (closing, TCPA <= 55 s, DCPA < 2.5 m), even
+    /// with the target still beyond d_D; the encounter is then held as one detected
+    /// within it. A target passing wide is no risk and gets no action beyond d_D.
     #[test]
     fn a_give_way_tow_acts_by_the_cpa_when_the_target_closes_fast() {
         let tow = tow_at(Pose::new(2.0, 0.0, 0.0), 0.1);
